@@ -1,0 +1,936 @@
+//! The element abstraction: every element exposes its nodal-coordinate slots, its
+//! named deformations ε = D(x) with D,x, D,xx\[a, b\] and Σ wᵢ Dᵢ,xx, its stress
+//! σ = Sε + Dε̇ + σ0 (thesis (E.2)), and its inertia (mass matrix, inertia force
+//! M ẍ + h and their derivatives). Elements without mass do no inertia work.
+
+use crate::beam_matrices::{
+    equivalent_stiffness, planar_a_diag, planar_beam_m_bar, planar_beam_s_bar, spatial_a_diag, spatial_beam_m_bar,
+    spatial_beam_s_bar,
+};
+use crate::inertia::{PlanarInertia, SpatialInertia, VelocityTransform, MAX_MODES};
+use crate::kernels::{
+    jacobian, second_directional, weighted_hessian, DefKernel, NormalizationKernel, PlanarBeamKernel,
+    PlanarHingeKernel, SpatialHingeKernel, TrussKernel, TwoNodeSpatial,
+};
+use crate::section::{positive, Material, SectionShape};
+use crate::superelement::LinearSuperelement;
+use crate::ElementError;
+use flexmb_dual::{Dual, Real};
+use nalgebra::{DMatrix, Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// A group of nodal coordinates an element connects to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Slot {
+    /// A planar point (x, y).
+    Position2,
+    /// A planar orientation angle φ.
+    Angle,
+    /// A spatial point (x, y, z).
+    Position3,
+    /// A spatial orientation as Euler parameters (λ0, λ1, λ2, λ3).
+    Orientation,
+    /// `n` superelement mode amplitudes η̄ (shareable between superelements).
+    Modes(usize),
+}
+
+impl Slot {
+    /// Number of coordinates in the slot.
+    pub fn len(&self) -> usize {
+        match self {
+            Slot::Position2 => 2,
+            Slot::Angle => 1,
+            Slot::Position3 => 3,
+            Slot::Orientation => 4,
+            Slot::Modes(n) => *n,
+        }
+    }
+    /// Whether the slot holds no coordinate.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Options of the beam elements.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BeamOptions {
+    /// Second-order elongation terms coupling bending into elongation: the
+    /// planar shortening term of (5.3a), and its spatial counterpart ("bowing").
+    pub shortening: bool,
+    /// Timoshenko (shear-flexible) bending; `false` gives Euler–Bernoulli.
+    pub timoshenko: bool,
+    /// Distributed mass (consistent, with rotary inertia); `false` for a massless beam.
+    pub inertia: bool,
+    /// The velocity transformation of the co-rotational inertia.
+    pub velocity_transform: VelocityTransform,
+}
+
+impl Default for BeamOptions {
+    fn default() -> Self {
+        Self {
+            shortening: true,
+            timoshenko: true,
+            inertia: true,
+            velocity_transform: VelocityTransform::B3,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Kind {
+    PlanarBeam(PlanarBeamKernel, Option<PlanarInertia>),
+    PlanarTruss { l0: f64, mass: f64 },
+    PlanarHinge,
+    PlanarMass { m: f64, j: Option<f64> },
+    /// Spatial beam or superelement (k extra modes).
+    TwoNode { kernel: TwoNodeSpatial, inertia: Option<SpatialInertia>, modes: usize },
+    Truss { l0: f64, mass: f64 },
+    Hinge { r0: [[f64; 3]; 3] },
+    PointMass { m: f64 },
+    RigidBody(SpatialInertia),
+    Normalization,
+}
+
+impl PartialEq for PlanarBeamKernel {
+    fn eq(&self, o: &Self) -> bool {
+        self.l0 == o.l0 && self.beta0 == o.beta0 && self.shortening == o.shortening
+    }
+}
+impl std::fmt::Debug for PlanarBeamKernel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "PlanarBeam(l0 = {}, β0 = {})", self.l0, self.beta0)
+    }
+}
+impl Clone for PlanarBeamKernel {
+    fn clone(&self) -> Self {
+        Self { ..*self }
+    }
+}
+impl PartialEq for TwoNodeSpatial {
+    fn eq(&self, o: &Self) -> bool {
+        self.l0 == o.l0 && self.r0 == o.r0 && self.bowing == o.bowing
+    }
+}
+impl std::fmt::Debug for TwoNodeSpatial {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "TwoNode(l0 = {})", self.l0)
+    }
+}
+impl Clone for TwoNodeSpatial {
+    fn clone(&self) -> Self {
+        Self { ..*self }
+    }
+}
+
+/// A non-linear finite element.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Element {
+    kind: Kind,
+    slots: Vec<Slot>,
+    names: Vec<String>,
+    stiffness: DMatrix<f64>,
+    damping: Option<DMatrix<f64>>,
+    sigma0: Option<Vec<f64>>,
+}
+
+/// An orthonormal frame with x along `axis` and y as close as possible to `up`.
+pub fn frame_from_axis(axis: &[f64; 3], up: &[f64; 3]) -> Result<[[f64; 3]; 3], ElementError> {
+    let x = Vector3::from(*axis);
+    let n = x.norm();
+    if !(n.is_finite() && n > 0.0) {
+        return Err(ElementError::Geometry(format!("axis {axis:?} has zero or non-finite length")));
+    }
+    let x = x / n;
+    let u = Vector3::from(*up);
+    let y = u - x * x.dot(&u);
+    let yn = y.norm();
+    if !(yn.is_finite() && yn > 1e-9 * u.norm().max(1e-300)) {
+        return Err(ElementError::Geometry(format!(
+            "the orientation vector {up:?} is parallel to the element axis {axis:?}; give another"
+        )));
+    }
+    let y = y / yn;
+    let z = x.cross(&y);
+    let m = Matrix3::from_columns(&[x, y, z]);
+    Ok(std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)])))
+}
+
+fn transpose3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[j][i]))
+}
+
+fn names(v: &[&str]) -> Vec<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
+fn diag(v: &[f64]) -> DMatrix<f64> {
+    DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(v))
+}
+
+fn dist(p: &[f64], q: &[f64]) -> f64 {
+    p.iter().zip(q).map(|(a, b)| (b - a) * (b - a)).sum::<f64>().sqrt()
+}
+
+const SPATIAL_NAMES: [&str; 6] = ["elongation", "torsion", "bending_y_p", "bending_y_q", "bending_z_p", "bending_z_q"];
+
+impl Element {
+    fn new(kind: Kind, slots: Vec<Slot>, names: Vec<String>, stiffness: DMatrix<f64>) -> Self {
+        Self {
+            kind,
+            slots,
+            names,
+            stiffness,
+            damping: None,
+            sigma0: None,
+        }
+    }
+
+    /// A planar beam from p to q (thesis (5.2)–(5.3)) with consistent mass.
+    pub fn planar_beam(
+        p: [f64; 2],
+        q: [f64; 2],
+        mat: &Material,
+        shape: &SectionShape,
+        opts: &BeamOptions,
+    ) -> Result<Self, ElementError> {
+        mat.validate()?;
+        let mut sec = shape.properties(mat.poisson())?;
+        if !opts.timoshenko {
+            sec = sec.euler_bernoulli();
+        }
+        let l0 = dist(&p, &q);
+        positive("planar beam length", l0)?;
+        let beta0 = (q[1] - p[1]).atan2(q[0] - p[0]);
+        let s_bar = DMatrix::from_iterator(3, 3, planar_beam_s_bar(mat, &sec, l0).iter().copied());
+        let s = equivalent_stiffness(&s_bar, &planar_a_diag(l0));
+        let inertia = (opts.inertia && mat.rho > 0.0).then(|| PlanarInertia {
+            nodes: 2,
+            variant: opts.velocity_transform,
+            beta0,
+            mbar: DMatrix::from_iterator(6, 6, planar_beam_m_bar(mat, &sec, l0).iter().copied()),
+        });
+        Ok(Self::new(
+            Kind::PlanarBeam(
+                PlanarBeamKernel {
+                    l0,
+                    beta0,
+                    shortening: opts.shortening,
+                },
+                inertia,
+            ),
+            vec![Slot::Position2, Slot::Angle, Slot::Position2, Slot::Angle],
+            names(&["elongation", "bending_p", "bending_q"]),
+            s,
+        ))
+    }
+
+    /// A planar truss (rod) with axial stiffness `ea` [N] and mass per length `rho_a` [kg/m].
+    pub fn planar_truss(p: [f64; 2], q: [f64; 2], ea: f64, rho_a: f64) -> Result<Self, ElementError> {
+        let l0 = dist(&p, &q);
+        positive("planar truss length", l0)?;
+        positive("truss EA", ea)?;
+        crate::section::non_negative("truss mass per length", rho_a)?;
+        Ok(Self::new(
+            Kind::PlanarTruss { l0, mass: rho_a * l0 },
+            vec![Slot::Position2, Slot::Position2],
+            names(&["elongation"]),
+            diag(&[ea / l0]),
+        ))
+    }
+
+    /// A planar hinge (thesis (5.5)) with rotational stiffness `k` [N m/rad] (may be 0).
+    pub fn planar_hinge(k: f64) -> Result<Self, ElementError> {
+        crate::section::non_negative("hinge stiffness", k)?;
+        Ok(Self::new(
+            Kind::PlanarHinge,
+            vec![Slot::Angle, Slot::Angle],
+            names(&["rotation"]),
+            diag(&[k]),
+        ))
+    }
+
+    /// A planar point mass, with rotary inertia `j` on an angle slot if given.
+    pub fn planar_mass(m: f64, j: Option<f64>) -> Result<Self, ElementError> {
+        positive("point mass", m)?;
+        let mut slots = vec![Slot::Position2];
+        if let Some(j) = j {
+            crate::section::non_negative("rotary inertia", j)?;
+            slots.push(Slot::Angle);
+        }
+        Ok(Self::new(Kind::PlanarMass { m, j }, slots, vec![], DMatrix::zeros(0, 0)))
+    }
+
+    /// A spatial beam from p to q (thesis (6.2)); local y is the part of `up`
+    /// orthogonal to the axis. Stiffness S = AᵀS̄A (3.20) from Timoshenko theory,
+    /// inertia by (2.34) with the 12×12 consistent mass.
+    pub fn beam(
+        p: [f64; 3],
+        q: [f64; 3],
+        up: [f64; 3],
+        mat: &Material,
+        shape: &SectionShape,
+        opts: &BeamOptions,
+    ) -> Result<Self, ElementError> {
+        mat.validate()?;
+        let mut sec = shape.properties(mat.poisson())?;
+        if !opts.timoshenko {
+            sec = sec.euler_bernoulli();
+        }
+        let axis = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+        let l0 = dist(&p, &q);
+        positive("beam length", l0)?;
+        let r0 = frame_from_axis(&axis, &up)?;
+        let s_bar = DMatrix::from_iterator(6, 6, spatial_beam_s_bar(mat, &sec, l0).iter().copied());
+        let m_bar = DMatrix::from_iterator(12, 12, spatial_beam_m_bar(mat, &sec, l0).iter().copied());
+        let inertia = (opts.inertia && mat.rho > 0.0).then_some(m_bar);
+        Ok(Self::two_node(l0, r0, &s_bar, inertia, 0, opts.shortening, opts.velocity_transform))
+    }
+
+    fn two_node(
+        l0: f64,
+        r0: [[f64; 3]; 3],
+        s_bar: &DMatrix<f64>,
+        m_bar: Option<DMatrix<f64>>,
+        modes: usize,
+        bowing: bool,
+        variant: VelocityTransform,
+    ) -> Self {
+        let s = equivalent_stiffness(s_bar, &spatial_a_diag(l0));
+        let inertia = m_bar.map(|mbar| SpatialInertia {
+            nodes: 2,
+            variant,
+            r0t: transpose3(&r0),
+            mbar,
+        });
+        let mut n = names(&SPATIAL_NAMES);
+        n.extend((0..modes).map(|i| format!("mode_{}", i + 1)));
+        Self::new(
+            Kind::TwoNode {
+                kernel: TwoNodeSpatial { l0, r0, bowing },
+                inertia,
+                modes,
+            },
+            vec![Slot::Position3, Slot::Orientation, Slot::Position3, Slot::Orientation],
+            n,
+            s,
+        )
+    }
+
+    /// The non-linear two-node superelement (thesis §2.3, §3.3) from linear
+    /// superelement data. Its slots are (rp, λp, rq, λq, η̄p, η̄q, η̄f): the
+    /// interface-mode slots can be shared with a neighbour's.
+    pub fn superelement(data: &LinearSuperelement, transform: VelocityTransform) -> Result<Self, ElementError> {
+        data.validate()?;
+        let k = data.n_modes();
+        let m_bar = data.m_bar_matrix();
+        let has_mass = m_bar.iter().any(|v| *v != 0.0);
+        let mut e = Self::two_node(
+            data.l0,
+            data.r0,
+            &data.s_bar_matrix(),
+            has_mass.then_some(m_bar),
+            k,
+            false,
+            transform,
+        );
+        let (kp, kq, kf) = data.mode_counts();
+        e.slots.extend([Slot::Modes(kp), Slot::Modes(kq), Slot::Modes(kf)]);
+        Ok(e)
+    }
+
+    /// A spatial truss (rod) with axial stiffness `ea` and mass per length `rho_a`.
+    pub fn truss(p: [f64; 3], q: [f64; 3], ea: f64, rho_a: f64) -> Result<Self, ElementError> {
+        let l0 = dist(&p, &q);
+        positive("truss length", l0)?;
+        positive("truss EA", ea)?;
+        crate::section::non_negative("truss mass per length", rho_a)?;
+        Ok(Self::new(
+            Kind::Truss { l0, mass: rho_a * l0 },
+            vec![Slot::Position3, Slot::Position3],
+            names(&["elongation"]),
+            diag(&[ea / l0]),
+        ))
+    }
+
+    /// A spatial hinge between two orientation nodes with its axis along `axis`
+    /// (in the initial configuration), rotational stiffness `k` about it and
+    /// stiffness `k_bend` for the two small bending deformations.
+    pub fn hinge(axis: [f64; 3], k: f64, k_bend: f64) -> Result<Self, ElementError> {
+        crate::section::non_negative("hinge stiffness", k)?;
+        crate::section::non_negative("hinge bending stiffness", k_bend)?;
+        let up = if axis[0].abs() < 0.9 * dist(&[0.0; 3], &axis) {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let r0 = frame_from_axis(&axis, &up)?;
+        Ok(Self::new(
+            Kind::Hinge { r0 },
+            vec![Slot::Orientation, Slot::Orientation],
+            names(&["rotation", "bending_y", "bending_z"]),
+            diag(&[k, k_bend, k_bend]),
+        ))
+    }
+
+    /// A spatial point mass.
+    pub fn point_mass(m: f64) -> Result<Self, ElementError> {
+        positive("point mass", m)?;
+        Ok(Self::new(Kind::PointMass { m }, vec![Slot::Position3], vec![], DMatrix::zeros(0, 0)))
+    }
+
+    /// A rigid body on a position + orientation node: mass `m`, centre of mass
+    /// `c` and inertia tensor `j` about the centre of mass, both in the body frame
+    /// `r0` (columns: body axes in the global frame at the initial configuration).
+    pub fn rigid_body(m: f64, c: [f64; 3], j: [[f64; 3]; 3], r0: [[f64; 3]; 3]) -> Result<Self, ElementError> {
+        positive("rigid body mass", m)?;
+        let jm = Matrix3::from_fn(|a, b| j[a][b]);
+        if (jm - jm.transpose()).norm() > 1e-12 * jm.norm() || jm.symmetric_eigenvalues().min() < 0.0 {
+            return Err(ElementError::InvalidProperty {
+                what: "rigid body inertia tensor".into(),
+                value: jm.symmetric_eigenvalues().min(),
+                why: "must be symmetric positive semi-definite".into(),
+            });
+        }
+        let cx = Matrix3::new(0.0, -c[2], c[1], c[2], 0.0, -c[0], -c[1], c[0], 0.0);
+        let mut mbar = DMatrix::zeros(6, 6);
+        let top_right = -cx * m;
+        let bottom = jm - cx * cx * m;
+        for a in 0..3 {
+            mbar[(a, a)] = m;
+            for b in 0..3 {
+                mbar[(a, 3 + b)] = top_right[(a, b)];
+                mbar[(3 + b, a)] = top_right[(a, b)];
+                mbar[(3 + a, 3 + b)] = bottom[(a, b)];
+            }
+        }
+        Ok(Self::new(
+            Kind::RigidBody(SpatialInertia {
+                nodes: 1,
+                variant: VelocityTransform::B1,
+                r0t: transpose3(&r0),
+                mbar,
+            }),
+            vec![Slot::Position3, Slot::Orientation],
+            vec![],
+            DMatrix::zeros(0, 0),
+        ))
+    }
+
+    /// The Euler-parameter normalization (λᵀλ − 1)/2 = 0 as a one-deformation
+    /// element on an orientation node: a rigid condition for the kinematics.
+    pub fn normalization() -> Self {
+        Self::new(
+            Kind::Normalization,
+            vec![Slot::Orientation],
+            names(&["normalization"]),
+            DMatrix::zeros(1, 1),
+        )
+    }
+
+    /// Sets the damping matrix in deformation space (n_ε × n_ε).
+    pub fn with_damping(mut self, d: DMatrix<f64>) -> Result<Self, ElementError> {
+        let n = self.n_eps();
+        if d.nrows() != n || d.ncols() != n || d.iter().any(|v| !v.is_finite()) {
+            return Err(ElementError::InvalidProperty {
+                what: "damping matrix".into(),
+                value: d.nrows() as f64,
+                why: format!("must be a finite {n} × {n} matrix"),
+            });
+        }
+        self.damping = Some(d);
+        Ok(self)
+    }
+
+    /// Sets the initial stress resultants σ0.
+    pub fn with_initial_stress(mut self, s0: Vec<f64>) -> Result<Self, ElementError> {
+        if s0.len() != self.n_eps() || s0.iter().any(|v| !v.is_finite()) {
+            return Err(ElementError::InvalidProperty {
+                what: "initial stress".into(),
+                value: s0.len() as f64,
+                why: format!("must hold {} finite values", self.n_eps()),
+            });
+        }
+        self.sigma0 = Some(s0);
+        Ok(self)
+    }
+
+    /// Replaces the stiffness matrix in deformation space (n_ε × n_ε).
+    pub fn with_stiffness(mut self, s: DMatrix<f64>) -> Result<Self, ElementError> {
+        let n = self.n_eps();
+        if s.nrows() != n || s.ncols() != n || s.iter().any(|v| !v.is_finite()) {
+            return Err(ElementError::InvalidProperty {
+                what: "stiffness matrix".into(),
+                value: s.nrows() as f64,
+                why: format!("must be a finite {n} × {n} matrix"),
+            });
+        }
+        self.stiffness = s;
+        Ok(self)
+    }
+
+    /// The nodal-coordinate slots in local order.
+    pub fn slots(&self) -> &[Slot] {
+        &self.slots
+    }
+    /// Number of local nodal coordinates.
+    pub fn n_x(&self) -> usize {
+        self.slots.iter().map(|s| s.len()).sum()
+    }
+    /// Number of deformations.
+    pub fn n_eps(&self) -> usize {
+        self.names.len()
+    }
+    /// Names of the deformations.
+    pub fn deformation_names(&self) -> &[String] {
+        &self.names
+    }
+    /// Stiffness S in deformation space.
+    pub fn stiffness(&self) -> &DMatrix<f64> {
+        &self.stiffness
+    }
+    /// Damping D in deformation space, if any.
+    pub fn damping(&self) -> Option<&DMatrix<f64>> {
+        self.damping.as_ref()
+    }
+    /// A short name of the element type.
+    pub fn type_name(&self) -> &'static str {
+        match &self.kind {
+            Kind::PlanarBeam(..) => "planar beam",
+            Kind::PlanarTruss { .. } => "planar truss",
+            Kind::PlanarHinge => "planar hinge",
+            Kind::PlanarMass { .. } => "planar mass",
+            Kind::TwoNode { modes, .. } => {
+                if *modes > 0 || self.slots.len() > 4 {
+                    "superelement"
+                } else {
+                    "beam"
+                }
+            }
+            Kind::Truss { .. } => "truss",
+            Kind::Hinge { .. } => "hinge",
+            Kind::PointMass { .. } => "point mass",
+            Kind::RigidBody(_) => "rigid body",
+            Kind::Normalization => "Euler-parameter normalization",
+        }
+    }
+
+    /// Whether the element has inertia (a massless element does no inertia work).
+    pub fn has_inertia(&self) -> bool {
+        match &self.kind {
+            Kind::PlanarBeam(_, i) => i.is_some(),
+            Kind::PlanarTruss { mass, .. } | Kind::Truss { mass, .. } => *mass > 0.0,
+            Kind::PlanarMass { .. } | Kind::PointMass { .. } | Kind::RigidBody(_) => true,
+            Kind::TwoNode { inertia, .. } => inertia.is_some(),
+            Kind::PlanarHinge | Kind::Hinge { .. } | Kind::Normalization => false,
+        }
+    }
+
+    /// The stress resultants σ = Sε + Dε̇ + σ0 (thesis (E.2)).
+    pub fn stress(&self, eps: &[f64], eps_dot: Option<&[f64]>, sigma: &mut [f64]) {
+        let n = self.n_eps();
+        for i in 0..n {
+            let mut s = self.sigma0.as_ref().map_or(0.0, |s0| s0[i]);
+            for j in 0..n {
+                s += self.stiffness[(i, j)] * eps[j];
+            }
+            if let (Some(d), Some(ed)) = (&self.damping, eps_dot) {
+                for j in 0..n {
+                    s += d[(i, j)] * ed[j];
+                }
+            }
+            sigma[i] = s;
+        }
+    }
+
+    /// Elastic energy ½ εᵀ S ε (+ σ0ᵀ ε).
+    pub fn elastic_energy(&self, eps: &[f64]) -> f64 {
+        let n = self.n_eps();
+        let mut e = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                e += 0.5 * eps[i] * self.stiffness[(i, j)] * eps[j];
+            }
+            if let Some(s0) = &self.sigma0 {
+                e += s0[i] * eps[i];
+            }
+        }
+        e
+    }
+}
+
+impl Element {
+    fn mode_count(&self) -> usize {
+        match &self.kind {
+            Kind::TwoNode { modes, .. } => *modes,
+            _ => 0,
+        }
+    }
+
+    /// ε = D(x). `prev` (the previous deformations) keeps hinge angles continuous
+    /// over many turns; pass `None` for the principal value.
+    pub fn deformations(&self, x: &[f64], prev: Option<&[f64]>, eps: &mut [f64]) {
+        macro_rules! go {
+            ($k:expr, $nx:literal, $ne:literal) => {{
+                let xa: [f64; $nx] = std::array::from_fn(|i| x[i]);
+                let e = DefKernel::<$nx, $ne>::eval($k, &xa);
+                eps[..$ne].copy_from_slice(&e);
+            }};
+        }
+        self.dispatch_def(x, prev, |k| match k {
+            KRef::Planar(k) => go!(k, 6, 3),
+            KRef::Truss2(k) => go!(k, 4, 1),
+            KRef::Hinge2(k) => go!(k, 2, 1),
+            KRef::TwoNode(k) => go!(k, 14, 6),
+            KRef::Truss3(k) => go!(k, 6, 1),
+            KRef::Hinge3(k) => go!(k, 8, 3),
+            KRef::Norm(k) => go!(k, 4, 1),
+        });
+        self.copy_modes(x, eps);
+    }
+
+    fn copy_modes(&self, x: &[f64], eps: &mut [f64]) {
+        let k = self.mode_count();
+        if k > 0 {
+            eps[6..6 + k].copy_from_slice(&x[14..14 + k]);
+        }
+    }
+
+    fn dispatch_def(&self, x: &[f64], prev: Option<&[f64]>, f: impl FnOnce(KRef<'_>)) {
+        match &self.kind {
+            Kind::PlanarBeam(k, _) => f(KRef::Planar(k)),
+            Kind::PlanarTruss { l0, .. } => f(KRef::Truss2(&TrussKernel { l0: *l0 })),
+            Kind::PlanarHinge => f(KRef::Hinge2(&PlanarHingeKernel)),
+            Kind::TwoNode { kernel, .. } => f(KRef::TwoNode(kernel)),
+            Kind::Truss { l0, .. } => f(KRef::Truss3(&TrussKernel { l0: *l0 })),
+            Kind::Hinge { r0 } => {
+                let xa: [f64; 8] = std::array::from_fn(|i| x[i]);
+                let a = SpatialHingeKernel::principal_angle(r0, &xa);
+                let offset = prev.map_or(0.0, |p| SpatialHingeKernel::unwrap_offset(a, p[0]));
+                f(KRef::Hinge3(&SpatialHingeKernel { r0: *r0, offset }))
+            }
+            Kind::Normalization => f(KRef::Norm(&NormalizationKernel)),
+            Kind::PlanarMass { .. } | Kind::PointMass { .. } | Kind::RigidBody(_) => {}
+        }
+    }
+
+    /// ε = D(x) and D,x (row-major n_ε × n_x).
+    pub fn deformations_and_jacobian(&self, x: &[f64], prev: Option<&[f64]>, eps: &mut [f64], jac: &mut [f64]) {
+        let nx = self.n_x();
+        macro_rules! go {
+            ($k:expr, $nx:literal, $ne:literal) => {{
+                let xa: [f64; $nx] = std::array::from_fn(|i| x[i]);
+                let (e, j) = jacobian::<_, $nx, $ne>($k, &xa);
+                eps[..$ne].copy_from_slice(&e);
+                for r in 0..$ne {
+                    jac[r * nx..r * nx + nx].fill(0.0);
+                    jac[r * nx..r * nx + $nx].copy_from_slice(&j[r]);
+                }
+            }};
+        }
+        self.dispatch_def(x, prev, |k| match k {
+            KRef::Planar(k) => go!(k, 6, 3),
+            KRef::Truss2(k) => go!(k, 4, 1),
+            KRef::Hinge2(k) => go!(k, 2, 1),
+            KRef::TwoNode(k) => go!(k, 14, 6),
+            KRef::Truss3(k) => go!(k, 6, 1),
+            KRef::Hinge3(k) => go!(k, 8, 3),
+            KRef::Norm(k) => go!(k, 4, 1),
+        });
+        let k = self.mode_count();
+        if k > 0 {
+            self.copy_modes(x, eps);
+            for r in 0..k {
+                let row = &mut jac[(6 + r) * nx..(7 + r) * nx];
+                row.fill(0.0);
+                row[14 + r] = 1.0;
+            }
+        }
+    }
+
+    /// The directional second derivative D,xx\[a, b\] (length n_ε): the
+    /// convective term with a = b = ẋ.
+    pub fn deformation_second_derivative(&self, x: &[f64], a: &[f64], b: &[f64], out: &mut [f64]) {
+        macro_rules! go {
+            ($k:expr, $nx:literal, $ne:literal) => {{
+                let xa: [f64; $nx] = std::array::from_fn(|i| x[i]);
+                let aa: [f64; $nx] = std::array::from_fn(|i| a[i]);
+                let ba: [f64; $nx] = std::array::from_fn(|i| b[i]);
+                let d = second_directional::<_, $nx, $ne>($k, &xa, &aa, &ba);
+                out[..$ne].copy_from_slice(&d);
+            }};
+        }
+        self.dispatch_def(x, None, |k| match k {
+            KRef::Planar(k) => go!(k, 6, 3),
+            KRef::Truss2(k) => go!(k, 4, 1),
+            KRef::Hinge2(k) => go!(k, 2, 1),
+            KRef::TwoNode(k) => go!(k, 14, 6),
+            KRef::Truss3(k) => go!(k, 6, 1),
+            KRef::Hinge3(k) => go!(k, 8, 3),
+            KRef::Norm(k) => go!(k, 4, 1),
+        });
+        let k = self.mode_count();
+        if k > 0 {
+            out[6..6 + k].fill(0.0);
+        }
+    }
+
+    /// The weighted Hessian Σᵢ wᵢ Dᵢ,xx (row-major n_x × n_x): the element's
+    /// contribution to the geometric stiffness.
+    pub fn deformation_weighted_hessian(&self, x: &[f64], w: &[f64], out: &mut [f64]) {
+        let nx = self.n_x();
+        out[..nx * nx].fill(0.0);
+        macro_rules! go {
+            ($k:expr, $nx:literal, $ne:literal) => {{
+                let xa: [f64; $nx] = std::array::from_fn(|i| x[i]);
+                let wa: [f64; $ne] = std::array::from_fn(|i| w[i]);
+                let h = weighted_hessian::<_, $nx, $ne>($k, &xa, &wa);
+                for r in 0..$nx {
+                    out[r * nx..r * nx + $nx].copy_from_slice(&h[r]);
+                }
+            }};
+        }
+        self.dispatch_def(x, None, |k| match k {
+            KRef::Planar(k) => go!(k, 6, 3),
+            KRef::Truss2(k) => go!(k, 4, 1),
+            KRef::Hinge2(k) => go!(k, 2, 1),
+            KRef::TwoNode(k) => go!(k, 14, 6),
+            KRef::Truss3(k) => go!(k, 6, 1),
+            KRef::Hinge3(k) => go!(k, 8, 3),
+            KRef::Norm(k) => go!(k, 4, 1),
+        });
+    }
+}
+
+enum KRef<'a> {
+    Planar(&'a PlanarBeamKernel),
+    Truss2(&'a TrussKernel),
+    Hinge2(&'a PlanarHingeKernel),
+    TwoNode(&'a TwoNodeSpatial),
+    Truss3(&'a TrussKernel),
+    Hinge3(&'a SpatialHingeKernel),
+    Norm(&'a NormalizationKernel),
+}
+
+/// The inertia force written over a [`Real`] scalar.
+trait InertiaForce {
+    fn force_generic<T: Real>(&self, x: &[T], xd: &[T], xdd: &[T], out: &mut [T]);
+}
+impl InertiaForce for SpatialInertia {
+    fn force_generic<T: Real>(&self, x: &[T], xd: &[T], xdd: &[T], out: &mut [T]) {
+        self.force(x, xd, xdd, out)
+    }
+}
+impl InertiaForce for PlanarInertia {
+    fn force_generic<T: Real>(&self, x: &[T], xd: &[T], xdd: &[T], out: &mut [T]) {
+        self.force(x, xd, xdd, out)
+    }
+}
+
+/// ∂F/∂x and ∂F/∂ẋ (row-major n × n) of F = M ẍ + h: the `N` node coordinates by
+/// one dual pass each, the mode-amplitude velocities by one directional pass each.
+fn force_derivatives<I: InertiaForce, const N: usize>(
+    inertia: &I,
+    n: usize,
+    x: &[f64],
+    xd: &[f64],
+    xdd: &[f64],
+    dfdx: &mut [f64],
+    dfdxd: &mut [f64],
+) {
+    dfdx[..n * n].fill(0.0);
+    dfdxd[..n * n].fill(0.0);
+    let mut out = [Dual::<f64, N>::constant(0.0); 14 + MAX_MODES];
+    let cst = |v: &[f64]| -> [Dual<f64, N>; 14 + MAX_MODES] {
+        std::array::from_fn(|i| Dual::constant(if i < n { v[i] } else { 0.0 }))
+    };
+    let seeded = |v: &[f64]| -> [Dual<f64, N>; 14 + MAX_MODES] {
+        std::array::from_fn(|i| {
+            if i < N {
+                Dual::variable(v[i], i)
+            } else {
+                Dual::constant(if i < n { v[i] } else { 0.0 })
+            }
+        })
+    };
+    // with respect to x (modes do not enter F)
+    inertia.force_generic(&seeded(x), &cst(xd), &cst(xdd), &mut out);
+    for r in 0..n {
+        dfdx[r * n..r * n + N].copy_from_slice(&out[r].eps);
+    }
+    // with respect to ẋ, node part
+    inertia.force_generic(&cst(x), &seeded(xd), &cst(xdd), &mut out);
+    for r in 0..n {
+        dfdxd[r * n..r * n + N].copy_from_slice(&out[r].eps);
+    }
+    // with respect to η̄̇
+    let mut o1 = [Dual::<f64, 1>::constant(0.0); 14 + MAX_MODES];
+    for c in N..n {
+        let x1: [Dual<f64, 1>; 14 + MAX_MODES] =
+            std::array::from_fn(|i| Dual::constant(if i < n { x[i] } else { 0.0 }));
+        let xdd1: [Dual<f64, 1>; 14 + MAX_MODES] =
+            std::array::from_fn(|i| Dual::constant(if i < n { xdd[i] } else { 0.0 }));
+        let xd1: [Dual<f64, 1>; 14 + MAX_MODES] = std::array::from_fn(|i| {
+            Dual::new(if i < n { xd[i] } else { 0.0 }, [if i == c { 1.0 } else { 0.0 }])
+        });
+        inertia.force_generic(&x1, &xd1, &xdd1, &mut o1);
+        for r in 0..n {
+            dfdxd[r * n + c] = o1[r].eps[0];
+        }
+    }
+}
+
+impl Element {
+    /// The mass matrix over the local nodal coordinates (row-major n_x × n_x);
+    /// zero for massless elements.
+    pub fn mass_matrix(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.n_x();
+        out[..n * n].fill(0.0);
+        match &self.kind {
+            Kind::PlanarBeam(_, Some(i)) => i.mass(x, out),
+            Kind::TwoNode { inertia: Some(i), .. } | Kind::RigidBody(i) => i.mass(x, out),
+            Kind::PlanarTruss { mass, .. } | Kind::Truss { mass, .. } => {
+                let d = n / 2;
+                for a in 0..d {
+                    out[a * n + a] = mass / 3.0;
+                    out[(a + d) * n + a + d] = mass / 3.0;
+                    out[a * n + a + d] = mass / 6.0;
+                    out[(a + d) * n + a] = mass / 6.0;
+                }
+            }
+            Kind::PlanarMass { m, j } => {
+                out[0] = *m;
+                out[n + 1] = *m;
+                if let Some(j) = j {
+                    out[2 * n + 2] = *j;
+                }
+            }
+            Kind::PointMass { m } => {
+                for a in 0..3 {
+                    out[a * n + a] = *m;
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// The inertia force M ẍ + h(x, ẋ) (thesis (2.40a), (3.34)).
+    pub fn inertia_force(&self, x: &[f64], xd: &[f64], xdd: &[f64], out: &mut [f64]) {
+        let n = self.n_x();
+        match &self.kind {
+            Kind::PlanarBeam(_, Some(i)) => i.force(x, xd, xdd, out),
+            Kind::TwoNode { inertia: Some(i), .. } | Kind::RigidBody(i) => i.force(x, xd, xdd, out),
+            Kind::PlanarTruss { .. } | Kind::Truss { .. } | Kind::PlanarMass { .. } | Kind::PointMass { .. } => {
+                // constant mass matrix: h = 0
+                let mut m = [0.0; 36];
+                self.mass_matrix(x, &mut m);
+                for r in 0..n {
+                    out[r] = (0..n).map(|c| m[r * n + c] * xdd[c]).sum();
+                }
+            }
+            _ => out[..n].fill(0.0),
+        }
+    }
+
+    /// The velocity-quadratic inertia force h(x, ẋ) = F(x, ẋ, 0).
+    pub fn inertia_h(&self, x: &[f64], xd: &[f64], out: &mut [f64]) {
+        let zero = [0.0; 14 + MAX_MODES];
+        self.inertia_force(x, xd, &zero[..self.n_x()], out)
+    }
+
+    /// ∂(M ẍ + h)/∂x and ∂h/∂ẋ (row-major n_x × n_x each), exact (Appendix E
+    /// needs them for the N and C matrices). ∂/∂ẍ is the mass matrix.
+    pub fn inertia_force_derivatives(
+        &self,
+        x: &[f64],
+        xd: &[f64],
+        xdd: &[f64],
+        dfdx: &mut [f64],
+        dfdxd: &mut [f64],
+    ) {
+        let n = self.n_x();
+        match &self.kind {
+            Kind::PlanarBeam(_, Some(i)) => force_derivatives::<_, 6>(i, n, x, xd, xdd, dfdx, dfdxd),
+            Kind::TwoNode { inertia: Some(i), .. } => force_derivatives::<_, 14>(i, n, x, xd, xdd, dfdx, dfdxd),
+            Kind::RigidBody(i) => force_derivatives::<_, 7>(i, n, x, xd, xdd, dfdx, dfdxd),
+            _ => {
+                dfdx[..n * n].fill(0.0);
+                dfdxd[..n * n].fill(0.0);
+            }
+        }
+    }
+
+    /// Kinetic energy T(x, ẋ).
+    pub fn kinetic_energy(&self, x: &[f64], xd: &[f64]) -> f64 {
+        match &self.kind {
+            Kind::PlanarBeam(_, Some(i)) => i.kinetic_energy(x, xd),
+            Kind::TwoNode { inertia: Some(i), .. } | Kind::RigidBody(i) => i.kinetic_energy(x, xd),
+            Kind::PlanarTruss { .. } | Kind::Truss { .. } | Kind::PlanarMass { .. } | Kind::PointMass { .. } => {
+                let n = self.n_x();
+                let mut m = [0.0; 36];
+                self.mass_matrix(x, &mut m);
+                let mut e = 0.0;
+                for r in 0..n {
+                    for c in 0..n {
+                        e += 0.5 * xd[r] * m[r * n + c] * xd[c];
+                    }
+                }
+                e
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The generalized force of gravity `g` (a uniform acceleration field),
+    /// f = M(x) ẋ_g with ẋ_g = g on every position coordinate: exact for rigid
+    /// motion of the element, including centre-of-mass offsets.
+    pub fn gravity_force(&self, x: &[f64], g: &[f64; 3], out: &mut [f64]) {
+        let n = self.n_x();
+        match &self.kind {
+            Kind::PlanarBeam(_, Some(i)) => i.gravity(x, g, out),
+            Kind::TwoNode { inertia: Some(i), .. } | Kind::RigidBody(i) => i.gravity(x, g, out),
+            Kind::PlanarTruss { .. } | Kind::Truss { .. } | Kind::PlanarMass { .. } | Kind::PointMass { .. } => {
+                let mut xg = [0.0; 6];
+                let dim = if matches!(self.kind, Kind::Truss { .. } | Kind::PointMass { .. }) { 3 } else { 2 };
+                let mut i = 0;
+                for s in &self.slots {
+                    if matches!(s, Slot::Position2 | Slot::Position3) {
+                        xg[i..i + dim].copy_from_slice(&g[..dim]);
+                    }
+                    i += s.len();
+                }
+                let zero = [0.0; 6];
+                self.inertia_force(x, &zero, &xg, out);
+            }
+            _ => out[..n].fill(0.0),
+        }
+    }
+
+    /// ∂f_gravity/∂x (row-major n_x × n_x): nonzero where the gravity force
+    /// depends on orientations.
+    pub fn gravity_force_derivative(&self, x: &[f64], g: &[f64; 3], out: &mut [f64]) {
+        let n = self.n_x();
+        out[..n * n].fill(0.0);
+        macro_rules! go {
+            ($i:expr, $N:literal) => {{
+                let xs: [Dual<f64, $N>; 14 + MAX_MODES] = std::array::from_fn(|k| {
+                    if k < $N {
+                        Dual::variable(x[k], k)
+                    } else {
+                        Dual::constant(if k < n { x[k] } else { 0.0 })
+                    }
+                });
+                let mut o = [Dual::<f64, $N>::constant(0.0); 14 + MAX_MODES];
+                $i.gravity(&xs, g, &mut o);
+                for r in 0..n {
+                    out[r * n..r * n + $N].copy_from_slice(&o[r].eps);
+                }
+            }};
+        }
+        match &self.kind {
+            Kind::PlanarBeam(_, Some(i)) => go!(i, 6),
+            Kind::TwoNode { inertia: Some(i), .. } => go!(i, 14),
+            Kind::RigidBody(i) => go!(i, 7),
+            _ => {}
+        }
+    }
+}

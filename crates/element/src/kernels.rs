@@ -1,0 +1,212 @@
+//! Deformation functions ε = D(x) of every element, written once over a
+//! [`Real`] scalar (thesis (5.3), (5.5), (6.2)), and the drivers that evaluate
+//! them with dual numbers to get D,x, D,xx\[a, b\] and Σ wᵢ Dᵢ,xx exactly.
+
+use flexmb_dual::{Dual, Dual2, Real, Vec3};
+use flexmb_rotation::generic::{rotation, triad_axis};
+
+/// A deformation function with `NX` local nodal coordinates and `NE` deformations.
+pub(crate) trait DefKernel<const NX: usize, const NE: usize> {
+    fn eval<T: Real>(&self, x: &[T; NX]) -> [T; NE];
+}
+
+/// ε and D,x (row-major `NE × NX`) by one forward pass with `NX` seeds.
+pub(crate) fn jacobian<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
+    k: &K,
+    x: &[f64; NX],
+) -> ([f64; NE], [[f64; NX]; NE]) {
+    let xd = Dual::<f64, NX>::seed(x);
+    let e = k.eval(&xd);
+    (e.map(|v| v.re), e.map(|v| v.eps))
+}
+
+/// The directional second derivative D,xx\[a, b\] (and D,x a as by-product).
+pub(crate) fn second_directional<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
+    k: &K,
+    x: &[f64; NX],
+    a: &[f64; NX],
+    b: &[f64; NX],
+) -> [f64; NE] {
+    let xd = Dual2::along2(x, a, b);
+    k.eval(&xd).map(|v| v.d2())
+}
+
+/// The weighted Hessian Σᵢ wᵢ Dᵢ,xx (`NX × NX`).
+pub(crate) fn weighted_hessian<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
+    k: &K,
+    x: &[f64; NX],
+    w: &[f64; NE],
+) -> [[f64; NX]; NX] {
+    let xd = Dual::<Dual<f64, NX>, NX>::seed2(x);
+    let e = k.eval(&xd);
+    let mut s = Dual::<Dual<f64, NX>, NX>::constant(Dual::constant(0.0));
+    for i in 0..NE {
+        if w[i] != 0.0 {
+            s += e[i] * w[i];
+        }
+    }
+    std::array::from_fn(|i| std::array::from_fn(|j| s.hess(i, j)))
+}
+
+#[inline]
+pub(crate) fn vec3<T: Real>(x: &[T], i: usize) -> Vec3<T> {
+    Vec3([x[i], x[i + 1], x[i + 2]])
+}
+
+#[inline]
+pub(crate) fn quat<T: Real>(x: &[T], i: usize) -> [T; 4] {
+    [x[i], x[i + 1], x[i + 2], x[i + 3]]
+}
+
+/// The six deformations of the spatial two-node beam / superelement, thesis
+/// (6.2b) = (2.15b) = (3.14b), on x = (rp, λp, rq, λq):
+/// ε1 = l − l0 (+ bowing), ε2 = l0 (ep_z·eq_y − ep_y·eq_z)/2, ε3 = −l0 el·ep_z,
+/// ε4 = l0 el·eq_z, ε5 = l0 el·ep_y, ε6 = −l0 el·eq_y.
+///
+/// With `bowing`, ε1 gains the second-order shortening of the axis due to
+/// bending, (2ε3² + ε3ε4 + 2ε4² + 2ε5² + ε5ε6 + 2ε6²)/(30 l0): the spatial
+/// counterpart of thesis (5.3a) (Jonker 1989, CMAME 76), with the cross-term sign
+/// fixed by these ε definitions (an arc, constant curvature, has ε3 = ε4 and
+/// ε5 = ε6 and shortens by l0θ²/6 for end slopes ±θ).
+pub(crate) struct TwoNodeSpatial {
+    pub l0: f64,
+    pub r0: [[f64; 3]; 3],
+    pub bowing: bool,
+}
+
+impl DefKernel<14, 6> for TwoNodeSpatial {
+    #[inline]
+    fn eval<T: Real>(&self, x: &[T; 14]) -> [T; 6] {
+        let rp = vec3(x, 0);
+        let rq = vec3(x, 7);
+        let mp = rotation(&quat(x, 3));
+        let mq = rotation(&quat(x, 10));
+        let (py, pz) = (triad_axis(&mp, &self.r0, 1), triad_axis(&mp, &self.r0, 2));
+        let (qy, qz) = (triad_axis(&mq, &self.r0, 1), triad_axis(&mq, &self.r0, 2));
+        let d = rq - rp;
+        let l = d.norm();
+        let l0 = self.l0;
+        let s = T::cst(l0) / l; // l0 el = s d
+        let e3 = -(d.dot(&pz) * s);
+        let e4 = d.dot(&qz) * s;
+        let e5 = d.dot(&py) * s;
+        let e6 = -(d.dot(&qy) * s);
+        let e2 = (pz.dot(&qy) - py.dot(&qz)) * (0.5 * l0);
+        let mut e1 = l - l0;
+        if self.bowing {
+            let b = (e3 * e3 + e4 * e4 + e5 * e5 + e6 * e6) * 2.0 + e3 * e4 + e5 * e6;
+            e1 += b * (1.0 / (30.0 * l0));
+        }
+        [e1, e2, e3, e4, e5, e6]
+    }
+}
+
+/// The planar beam of thesis (5.3) on x = (xp, yp, φp, xq, yq, φq):
+/// ε1 = l − l0 + (2ε2² + ε2ε3 + 2ε3²)/(30 l0) (the shortening term optional),
+/// ε2 = (l0/l)(Δx sin(φp+β0) − Δy cos(φp+β0)), ε3 = −(l0/l)(Δx sin(φq+β0) − Δy cos(φq+β0)).
+pub(crate) struct PlanarBeamKernel {
+    pub l0: f64,
+    pub beta0: f64,
+    pub shortening: bool,
+}
+
+impl DefKernel<6, 3> for PlanarBeamKernel {
+    #[inline]
+    fn eval<T: Real>(&self, x: &[T; 6]) -> [T; 3] {
+        let dx = x[3] - x[0];
+        let dy = x[4] - x[1];
+        let l = (dx * dx + dy * dy).sqrt();
+        let s = T::cst(self.l0) / l;
+        let ap = x[2] + self.beta0;
+        let aq = x[5] + self.beta0;
+        let e2 = (dx * ap.sin() - dy * ap.cos()) * s;
+        let e3 = -((dx * aq.sin() - dy * aq.cos()) * s);
+        let mut e1 = l - self.l0;
+        if self.shortening {
+            e1 += ((e2 * e2 + e3 * e3) * 2.0 + e2 * e3) * (1.0 / (30.0 * self.l0));
+        }
+        [e1, e2, e3]
+    }
+}
+
+/// A truss (rod) between two points of dimension `D`: ε = l − l0.
+pub(crate) struct TrussKernel {
+    pub l0: f64,
+}
+
+impl DefKernel<4, 1> for TrussKernel {
+    #[inline]
+    fn eval<T: Real>(&self, x: &[T; 4]) -> [T; 1] {
+        let dx = x[2] - x[0];
+        let dy = x[3] - x[1];
+        [(dx * dx + dy * dy).sqrt() - self.l0]
+    }
+}
+
+impl DefKernel<6, 1> for TrussKernel {
+    #[inline]
+    fn eval<T: Real>(&self, x: &[T; 6]) -> [T; 1] {
+        let d = vec3(x, 3) - vec3(x, 0);
+        [d.norm() - self.l0]
+    }
+}
+
+/// The planar hinge of thesis (5.5): ε = φq − φp.
+pub(crate) struct PlanarHingeKernel;
+
+impl DefKernel<2, 1> for PlanarHingeKernel {
+    #[inline]
+    fn eval<T: Real>(&self, x: &[T; 2]) -> [T; 1] {
+        [x[1] - x[0]]
+    }
+}
+
+/// The spatial hinge on x = (λp, λq) with its axis along the local x-axis of R0:
+/// ε1 = the relative rotation about the axis, continuous over any number of turns
+/// (atan2 of the triad products plus `turns` · 2π chosen against the previous
+/// value), ε2 = (ep_x·eq_z − ep_z·eq_x)/2 and ε3 = (ep_y·eq_x − ep_x·eq_y)/2 the
+/// small relative rotations about the other two axes (normally rigid).
+pub(crate) struct SpatialHingeKernel {
+    pub r0: [[f64; 3]; 3],
+    /// 2πk added to ε1 (a constant: it does not change derivatives).
+    pub offset: f64,
+}
+
+impl SpatialHingeKernel {
+    /// The angle in (−π, π] from primal values only.
+    pub fn principal_angle(r0: &[[f64; 3]; 3], x: &[f64; 8]) -> f64 {
+        let k = SpatialHingeKernel { r0: *r0, offset: 0.0 };
+        k.eval(x)[0]
+    }
+    /// The 2πk that puts the principal angle `a` closest to `prev`.
+    pub fn unwrap_offset(a: f64, prev: f64) -> f64 {
+        let two_pi = 2.0 * std::f64::consts::PI;
+        ((prev - a) / two_pi).round() * two_pi
+    }
+}
+
+impl DefKernel<8, 3> for SpatialHingeKernel {
+    #[inline]
+    fn eval<T: Real>(&self, x: &[T; 8]) -> [T; 3] {
+        let mp = rotation(&quat(x, 0));
+        let mq = rotation(&quat(x, 4));
+        let p: [Vec3<T>; 3] = std::array::from_fn(|j| triad_axis(&mp, &self.r0, j));
+        let q: [Vec3<T>; 3] = std::array::from_fn(|j| triad_axis(&mq, &self.r0, j));
+        let s = p[2].dot(&q[1]) - p[1].dot(&q[2]);
+        let c = p[1].dot(&q[1]) + p[2].dot(&q[2]);
+        let e1 = s.atan2(c) + self.offset;
+        let e2 = (p[0].dot(&q[2]) - p[2].dot(&q[0])) * 0.5;
+        let e3 = (p[1].dot(&q[0]) - p[0].dot(&q[1])) * 0.5;
+        [e1, e2, e3]
+    }
+}
+
+/// The Euler-parameter normalization as a rigid deformation: ε = (λᵀλ − 1)/2.
+pub(crate) struct NormalizationKernel;
+
+impl DefKernel<4, 1> for NormalizationKernel {
+    #[inline]
+    fn eval<T: Real>(&self, x: &[T; 4]) -> [T; 1] {
+        [(x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3] - 1.0) * 0.5]
+    }
+}

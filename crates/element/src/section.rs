@@ -1,0 +1,260 @@
+//! Materials and cross-section properties of beams.
+//!
+//! Local beam axes: x along the beam (from node p to node q), y and z the
+//! principal axes of the cross-section. Bending "about z" deflects in the xy-plane
+//! and uses `iz` and the shear factor `ky` (shear in y).
+
+use crate::ElementError;
+use serde::{Deserialize, Serialize};
+
+/// A linear elastic isotropic material.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    /// Young's modulus E [Pa].
+    pub e: f64,
+    /// Shear modulus G [Pa].
+    pub g: f64,
+    /// Density ρ [kg/m³].
+    pub rho: f64,
+}
+
+impl Material {
+    /// From E, Poisson's ratio ν and ρ (G = E / (2(1 + ν))).
+    pub fn from_poisson(e: f64, nu: f64, rho: f64) -> Self {
+        Self {
+            e,
+            g: e / (2.0 * (1.0 + nu)),
+            rho,
+        }
+    }
+    /// Poisson's ratio implied by E and G.
+    pub fn poisson(&self) -> f64 {
+        self.e / (2.0 * self.g) - 1.0
+    }
+    /// Checks that E, G are positive and ρ non-negative, all finite.
+    pub fn validate(&self) -> Result<(), ElementError> {
+        positive("Young's modulus E", self.e)?;
+        positive("shear modulus G", self.g)?;
+        non_negative("density rho", self.rho)
+    }
+}
+
+/// Cross-section properties used by the beam elements.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SectionProperties {
+    /// Area A [m²].
+    pub area: f64,
+    /// Second moment of area about local y, Iy [m⁴] (bending in the xz-plane).
+    pub iy: f64,
+    /// Second moment of area about local z, Iz [m⁴] (bending in the xy-plane).
+    pub iz: f64,
+    /// Torsion constant J [m⁴] (St Venant).
+    pub j: f64,
+    /// Shear correction factor for shear in y (κy); `f64::INFINITY` gives Euler–Bernoulli.
+    pub ky: f64,
+    /// Shear correction factor for shear in z (κz); `f64::INFINITY` gives Euler–Bernoulli.
+    pub kz: f64,
+}
+
+impl SectionProperties {
+    /// Polar second moment of area Iy + Iz (rotary inertia about the axis).
+    pub fn polar(&self) -> f64 {
+        self.iy + self.iz
+    }
+    /// Checks positivity and finiteness (shear factors may be infinite).
+    pub fn validate(&self) -> Result<(), ElementError> {
+        positive("section area", self.area)?;
+        positive("section Iy", self.iy)?;
+        positive("section Iz", self.iz)?;
+        positive("section torsion constant J", self.j)?;
+        for (n, v) in [("shear factor ky", self.ky), ("shear factor kz", self.kz)] {
+            if v.is_nan() || v <= 0.0 {
+                return Err(ElementError::InvalidProperty {
+                    what: n.into(),
+                    value: v,
+                    why: "must be positive (use infinity for Euler–Bernoulli)".into(),
+                });
+            }
+        }
+        Ok(())
+    }
+    /// The same section without shear flexibility (Euler–Bernoulli bending).
+    pub fn euler_bernoulli(mut self) -> Self {
+        self.ky = f64::INFINITY;
+        self.kz = f64::INFINITY;
+        self
+    }
+}
+
+/// A cross-section shape from which [`SectionProperties`] follow.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum SectionShape {
+    /// A solid rectangle with side `by` along local y and `bz` along local z.
+    Rectangle {
+        /// Side along local y [m].
+        by: f64,
+        /// Side along local z [m].
+        bz: f64,
+    },
+    /// A solid circle.
+    Circle {
+        /// Diameter [m].
+        d: f64,
+    },
+    /// A circular tube.
+    Tube {
+        /// Outer diameter [m].
+        d_outer: f64,
+        /// Inner diameter [m].
+        d_inner: f64,
+    },
+    /// Properties given directly.
+    User(SectionProperties),
+}
+
+impl SectionShape {
+    /// The section properties; shear factors from Cowper (1966), which depend on
+    /// Poisson's ratio ν: rectangle 10(1+ν)/(12+11ν), solid circle
+    /// 6(1+ν)/(7+6ν), tube (general hollow circle formula of Cowper with
+    /// m = d_inner/d_outer).
+    pub fn properties(&self, nu: f64) -> Result<SectionProperties, ElementError> {
+        let p = match *self {
+            SectionShape::Rectangle { by, bz } => {
+                positive("rectangle side by", by)?;
+                positive("rectangle side bz", bz)?;
+                let k = 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu);
+                SectionProperties {
+                    area: by * bz,
+                    iy: by * bz.powi(3) / 12.0,
+                    iz: bz * by.powi(3) / 12.0,
+                    j: rectangle_torsion_constant(by, bz),
+                    ky: k,
+                    kz: k,
+                }
+            }
+            SectionShape::Circle { d } => {
+                positive("circle diameter", d)?;
+                let i = std::f64::consts::PI * d.powi(4) / 64.0;
+                let k = 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu);
+                SectionProperties {
+                    area: std::f64::consts::PI * d * d / 4.0,
+                    iy: i,
+                    iz: i,
+                    j: 2.0 * i,
+                    ky: k,
+                    kz: k,
+                }
+            }
+            SectionShape::Tube { d_outer, d_inner } => {
+                positive("tube outer diameter", d_outer)?;
+                non_negative("tube inner diameter", d_inner)?;
+                if d_inner >= d_outer {
+                    return Err(ElementError::InvalidProperty {
+                        what: "tube inner diameter".into(),
+                        value: d_inner,
+                        why: format!("must be smaller than the outer diameter {d_outer}"),
+                    });
+                }
+                let pi = std::f64::consts::PI;
+                let i = pi * (d_outer.powi(4) - d_inner.powi(4)) / 64.0;
+                let m = d_inner / d_outer;
+                let m2 = m * m;
+                let k = 6.0 * (1.0 + nu) * (1.0 + m2).powi(2)
+                    / ((7.0 + 6.0 * nu) * (1.0 + m2).powi(2) + (20.0 + 12.0 * nu) * m2);
+                SectionProperties {
+                    area: pi * (d_outer * d_outer - d_inner * d_inner) / 4.0,
+                    iy: i,
+                    iz: i,
+                    j: 2.0 * i,
+                    ky: k,
+                    kz: k,
+                }
+            }
+            SectionShape::User(p) => p,
+        };
+        p.validate()?;
+        Ok(p)
+    }
+}
+
+/// St Venant torsion constant of a solid rectangle a × b from the standard
+/// series (Timoshenko & Goodier, *Theory of Elasticity*, §109):
+/// J = (a b³/3) [1 − (192/π⁵)(b/a) Σ_{n odd} tanh(nπa/(2b))/n⁵], a ≥ b.
+/// Summed until the terms are below 1e-17 relative.
+pub fn rectangle_torsion_constant(s1: f64, s2: f64) -> f64 {
+    let (a, b) = if s1 >= s2 { (s1, s2) } else { (s2, s1) };
+    let pi = std::f64::consts::PI;
+    let mut sum = 0.0;
+    let mut n = 1.0f64;
+    loop {
+        let t = (n * pi * a / (2.0 * b)).tanh() / n.powi(5);
+        sum += t;
+        if t < 1e-17 * sum {
+            break;
+        }
+        n += 2.0;
+    }
+    a * b.powi(3) / 3.0 * (1.0 - 192.0 / pi.powi(5) * (b / a) * sum)
+}
+
+pub(crate) fn positive(what: &str, v: f64) -> Result<(), ElementError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(ElementError::InvalidProperty {
+            what: what.into(),
+            value: v,
+            why: "must be positive and finite".into(),
+        })
+    }
+}
+
+pub(crate) fn non_negative(what: &str, v: f64) -> Result<(), ElementError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(ElementError::InvalidProperty {
+            what: what.into(),
+            value: v,
+            why: "must be non-negative and finite".into(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn square_torsion_constant_matches_tabulated_value() {
+        // Roark / Timoshenko: square a = b: J = 0.1406 a⁴ (0.140577...)
+        let j = rectangle_torsion_constant(1.0, 1.0);
+        assert!((j - 0.140_577).abs() < 2e-6, "{j}");
+        // thin strip: J → a b³/3 (1 − 0.630 b/a)
+        let j = rectangle_torsion_constant(0.03, 0.001);
+        let approx = 0.03 * 1e-9 / 3.0 * (1.0 - 0.630_2 * 0.001 / 0.03);
+        assert!((j / approx - 1.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn invalid_sections_are_rejected_with_a_name() {
+        let e = SectionShape::Rectangle { by: 0.0, bz: 1.0 }
+            .properties(0.3)
+            .unwrap_err();
+        assert!(e.to_string().contains("rectangle side by"));
+        let e = SectionShape::Tube {
+            d_outer: 1.0,
+            d_inner: 2.0,
+        }
+        .properties(0.3)
+        .unwrap_err();
+        assert!(e.to_string().contains("inner diameter"));
+        assert!(Material {
+            e: f64::NAN,
+            g: 1.0,
+            rho: 1.0
+        }
+        .validate()
+        .is_err());
+    }
+}
