@@ -45,7 +45,7 @@ impl<T: Real, const N: usize> Dual<T, N> {
     fn chain(self, f: T, df: T) -> Self {
         let mut eps = self.eps;
         for e in eps.iter_mut() {
-            *e = *e * df;
+            *e *= df;
         }
         Self { re: f, eps }
     }
@@ -68,12 +68,7 @@ impl Dual<f64, 1> {
 impl Dual<Dual<f64, 1>, 1> {
     /// `x + ε₁ a + ε₂ b` (ε₁ε₂ kept): the ε₁ε₂ part of f gives f,xx\[a, b\].
     pub fn along2<const M: usize>(x: &[f64; M], a: &[f64; M], b: &[f64; M]) -> [Self; M] {
-        std::array::from_fn(|i| {
-            Self::new(
-                Dual::new(x[i], [b[i]]),
-                [Dual::new(a[i], [0.0])],
-            )
-        })
+        std::array::from_fn(|i| Self::new(Dual::new(x[i], [b[i]]), [Dual::new(a[i], [0.0])]))
     }
     /// The mixed second-derivative part (coefficient of ε₁ε₂).
     #[inline]

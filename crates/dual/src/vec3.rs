@@ -122,20 +122,12 @@ impl<T: Real> Mat3<T> {
     /// Matrix–vector product.
     #[inline]
     pub fn mul_vec(&self, v: &Vec3<T>) -> Vec3<T> {
-        Vec3([
-            self.row(0).dot(v),
-            self.row(1).dot(v),
-            self.row(2).dot(v),
-        ])
+        Vec3([self.row(0).dot(v), self.row(1).dot(v), self.row(2).dot(v)])
     }
     /// Transposed matrix–vector product `Mᵀ v`.
     #[inline]
     pub fn tr_mul_vec(&self, v: &Vec3<T>) -> Vec3<T> {
-        Vec3([
-            self.col(0).dot(v),
-            self.col(1).dot(v),
-            self.col(2).dot(v),
-        ])
+        Vec3([self.col(0).dot(v), self.col(1).dot(v), self.col(2).dot(v)])
     }
     /// Matrix product.
     pub fn mul_mat(&self, o: &Self) -> Self {

@@ -21,10 +21,13 @@ pub fn shear_parameter(mat: &Material, sec: &SectionProperties, i: f64, kappa: f
 }
 
 /// Two-node bending stiffness over the end rotations (θp, θq) relative to the
-/// chord: E I/(l(1+Φ)) [[4+Φ, 2−Φ], [2−Φ, 4+Φ]].
+/// chord: E I/(l(1+Φ)) ((4+Φ, 2−Φ), (2−Φ, 4+Φ)).
 fn bending_block(ei: f64, phi: f64, l: f64) -> [[f64; 2]; 2] {
     let c = ei / (l * (1.0 + phi));
-    [[c * (4.0 + phi), c * (2.0 - phi)], [c * (2.0 - phi), c * (4.0 + phi)]]
+    [
+        [c * (4.0 + phi), c * (2.0 - phi)],
+        [c * (2.0 - phi), c * (4.0 + phi)],
+    ]
 }
 
 /// S̄ of a spatial Timoshenko beam over µ̄e = (ū^q_x, φ̄^q_x, φ̄^p_y, φ̄^q_y, φ̄^p_z, φ̄^q_z),
@@ -34,9 +37,17 @@ pub fn spatial_beam_s_bar(mat: &Material, sec: &SectionProperties, l: f64) -> SM
     s[(0, 0)] = mat.e * sec.area / l;
     s[(1, 1)] = mat.g * sec.j / l;
     // bending about y (deflection in z): shear in z
-    let by = bending_block(mat.e * sec.iy, shear_parameter(mat, sec, sec.iy, sec.kz, l), l);
+    let by = bending_block(
+        mat.e * sec.iy,
+        shear_parameter(mat, sec, sec.iy, sec.kz, l),
+        l,
+    );
     // bending about z (deflection in y): shear in y
-    let bz = bending_block(mat.e * sec.iz, shear_parameter(mat, sec, sec.iz, sec.ky, l), l);
+    let bz = bending_block(
+        mat.e * sec.iz,
+        shear_parameter(mat, sec, sec.iz, sec.ky, l),
+        l,
+    );
     for a in 0..2 {
         for b in 0..2 {
             s[(2 + a, 2 + b)] = by[a][b];
@@ -50,7 +61,11 @@ pub fn spatial_beam_s_bar(mat: &Material, sec: &SectionProperties, l: f64) -> SM
 pub fn planar_beam_s_bar(mat: &Material, sec: &SectionProperties, l: f64) -> SMatrix<f64, 3, 3> {
     let mut s = SMatrix::<f64, 3, 3>::zeros();
     s[(0, 0)] = mat.e * sec.area / l;
-    let bz = bending_block(mat.e * sec.iz, shear_parameter(mat, sec, sec.iz, sec.ky, l), l);
+    let bz = bending_block(
+        mat.e * sec.iz,
+        shear_parameter(mat, sec, sec.iz, sec.ky, l),
+        l,
+    );
     for a in 0..2 {
         for b in 0..2 {
             s[(1 + a, 1 + b)] = bz[a][b];
@@ -70,7 +85,7 @@ pub fn planar_a_diag(l0: f64) -> [f64; 3] {
     [1.0, 1.0 / l0, -1.0 / l0]
 }
 
-/// S = [A; I]ᵀ S̄ [A; I] of thesis (3.20): S̄ over (µ̄e, η̄) with `a` the diagonal
+/// S = \[A; I\]ᵀ S̄ \[A; I\] of thesis (3.20): S̄ over (µ̄e, η̄) with `a` the diagonal
 /// of A over the first `a.len()` entries and the identity on the mode amplitudes.
 pub fn equivalent_stiffness(s_bar: &DMatrix<f64>, a: &[f64]) -> DMatrix<f64> {
     let n = s_bar.nrows();

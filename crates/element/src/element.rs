@@ -4,13 +4,13 @@
 //! M ẍ + h and their derivatives). Elements without mass do no inertia work.
 
 use crate::beam_matrices::{
-    equivalent_stiffness, planar_a_diag, planar_beam_m_bar, planar_beam_s_bar, spatial_a_diag, spatial_beam_m_bar,
-    spatial_beam_s_bar,
+    equivalent_stiffness, planar_a_diag, planar_beam_m_bar, planar_beam_s_bar, spatial_a_diag,
+    spatial_beam_m_bar, spatial_beam_s_bar,
 };
 use crate::inertia::{PlanarInertia, SpatialInertia, VelocityTransform, MAX_MODES};
 use crate::kernels::{
-    jacobian, second_directional, weighted_hessian, DefKernel, NormalizationKernel, PlanarBeamKernel,
-    PlanarHingeKernel, SpatialHingeKernel, TrussKernel, TwoNodeSpatial,
+    jacobian, second_directional, weighted_hessian, DefKernel, NormalizationKernel,
+    PlanarBeamKernel, PlanarHingeKernel, SpatialHingeKernel, TrussKernel, TwoNodeSpatial,
 };
 use crate::section::{positive, Material, SectionShape};
 use crate::superelement::LinearSuperelement;
@@ -79,14 +79,31 @@ impl Default for BeamOptions {
 #[derive(Clone, Debug, PartialEq)]
 enum Kind {
     PlanarBeam(PlanarBeamKernel, Option<PlanarInertia>),
-    PlanarTruss { l0: f64, mass: f64 },
+    PlanarTruss {
+        l0: f64,
+        mass: f64,
+    },
     PlanarHinge,
-    PlanarMass { m: f64, j: Option<f64> },
+    PlanarMass {
+        m: f64,
+        j: Option<f64>,
+    },
     /// Spatial beam or superelement (k extra modes).
-    TwoNode { kernel: TwoNodeSpatial, inertia: Option<SpatialInertia>, modes: usize },
-    Truss { l0: f64, mass: f64 },
-    Hinge { r0: [[f64; 3]; 3] },
-    PointMass { m: f64 },
+    TwoNode {
+        kernel: TwoNodeSpatial,
+        inertia: Option<SpatialInertia>,
+        modes: usize,
+    },
+    Truss {
+        l0: f64,
+        mass: f64,
+    },
+    Hinge {
+        r0: [[f64; 3]; 3],
+    },
+    PointMass {
+        m: f64,
+    },
     RigidBody(SpatialInertia),
     Normalization,
 }
@@ -138,7 +155,9 @@ pub fn frame_from_axis(axis: &[f64; 3], up: &[f64; 3]) -> Result<[[f64; 3]; 3], 
     let x = Vector3::from(*axis);
     let n = x.norm();
     if !(n.is_finite() && n > 0.0) {
-        return Err(ElementError::Geometry(format!("axis {axis:?} has zero or non-finite length")));
+        return Err(ElementError::Geometry(format!(
+            "axis {axis:?} has zero or non-finite length"
+        )));
     }
     let x = x / n;
     let u = Vector3::from(*up);
@@ -168,10 +187,21 @@ fn diag(v: &[f64]) -> DMatrix<f64> {
 }
 
 fn dist(p: &[f64], q: &[f64]) -> f64 {
-    p.iter().zip(q).map(|(a, b)| (b - a) * (b - a)).sum::<f64>().sqrt()
+    p.iter()
+        .zip(q)
+        .map(|(a, b)| (b - a) * (b - a))
+        .sum::<f64>()
+        .sqrt()
 }
 
-const SPATIAL_NAMES: [&str; 6] = ["elongation", "torsion", "bending_y_p", "bending_y_q", "bending_z_p", "bending_z_q"];
+const SPATIAL_NAMES: [&str; 6] = [
+    "elongation",
+    "torsion",
+    "bending_y_p",
+    "bending_y_q",
+    "bending_z_p",
+    "bending_z_q",
+];
 
 impl Element {
     fn new(kind: Kind, slots: Vec<Slot>, names: Vec<String>, stiffness: DMatrix<f64>) -> Self {
@@ -224,21 +254,29 @@ impl Element {
         ))
     }
 
-    /// A planar truss (rod) with axial stiffness `ea` [N] and mass per length `rho_a` [kg/m].
-    pub fn planar_truss(p: [f64; 2], q: [f64; 2], ea: f64, rho_a: f64) -> Result<Self, ElementError> {
+    /// A planar truss (rod) with axial stiffness `ea` (N) and mass per length `rho_a` (kg/m).
+    pub fn planar_truss(
+        p: [f64; 2],
+        q: [f64; 2],
+        ea: f64,
+        rho_a: f64,
+    ) -> Result<Self, ElementError> {
         let l0 = dist(&p, &q);
         positive("planar truss length", l0)?;
         positive("truss EA", ea)?;
         crate::section::non_negative("truss mass per length", rho_a)?;
         Ok(Self::new(
-            Kind::PlanarTruss { l0, mass: rho_a * l0 },
+            Kind::PlanarTruss {
+                l0,
+                mass: rho_a * l0,
+            },
             vec![Slot::Position2, Slot::Position2],
             names(&["elongation"]),
             diag(&[ea / l0]),
         ))
     }
 
-    /// A planar hinge (thesis (5.5)) with rotational stiffness `k` [N m/rad] (may be 0).
+    /// A planar hinge (thesis (5.5)) with rotational stiffness `k` (N m/rad) (may be 0).
     pub fn planar_hinge(k: f64) -> Result<Self, ElementError> {
         crate::section::non_negative("hinge stiffness", k)?;
         Ok(Self::new(
@@ -257,7 +295,12 @@ impl Element {
             crate::section::non_negative("rotary inertia", j)?;
             slots.push(Slot::Angle);
         }
-        Ok(Self::new(Kind::PlanarMass { m, j }, slots, vec![], DMatrix::zeros(0, 0)))
+        Ok(Self::new(
+            Kind::PlanarMass { m, j },
+            slots,
+            vec![],
+            DMatrix::zeros(0, 0),
+        ))
     }
 
     /// A spatial beam from p to q (thesis (6.2)); local y is the part of `up`
@@ -281,9 +324,18 @@ impl Element {
         positive("beam length", l0)?;
         let r0 = frame_from_axis(&axis, &up)?;
         let s_bar = DMatrix::from_iterator(6, 6, spatial_beam_s_bar(mat, &sec, l0).iter().copied());
-        let m_bar = DMatrix::from_iterator(12, 12, spatial_beam_m_bar(mat, &sec, l0).iter().copied());
+        let m_bar =
+            DMatrix::from_iterator(12, 12, spatial_beam_m_bar(mat, &sec, l0).iter().copied());
         let inertia = (opts.inertia && mat.rho > 0.0).then_some(m_bar);
-        Ok(Self::two_node(l0, r0, &s_bar, inertia, 0, opts.shortening, opts.velocity_transform))
+        Ok(Self::two_node(
+            l0,
+            r0,
+            &s_bar,
+            inertia,
+            0,
+            opts.shortening,
+            opts.velocity_transform,
+        ))
     }
 
     fn two_node(
@@ -310,7 +362,12 @@ impl Element {
                 inertia,
                 modes,
             },
-            vec![Slot::Position3, Slot::Orientation, Slot::Position3, Slot::Orientation],
+            vec![
+                Slot::Position3,
+                Slot::Orientation,
+                Slot::Position3,
+                Slot::Orientation,
+            ],
             n,
             s,
         )
@@ -319,7 +376,10 @@ impl Element {
     /// The non-linear two-node superelement (thesis §2.3, §3.3) from linear
     /// superelement data. Its slots are (rp, λp, rq, λq, η̄p, η̄q, η̄f): the
     /// interface-mode slots can be shared with a neighbour's.
-    pub fn superelement(data: &LinearSuperelement, transform: VelocityTransform) -> Result<Self, ElementError> {
+    pub fn superelement(
+        data: &LinearSuperelement,
+        transform: VelocityTransform,
+    ) -> Result<Self, ElementError> {
         data.validate()?;
         let k = data.n_modes();
         let m_bar = data.m_bar_matrix();
@@ -334,7 +394,8 @@ impl Element {
             transform,
         );
         let (kp, kq, kf) = data.mode_counts();
-        e.slots.extend([Slot::Modes(kp), Slot::Modes(kq), Slot::Modes(kf)]);
+        e.slots
+            .extend([Slot::Modes(kp), Slot::Modes(kq), Slot::Modes(kf)]);
         Ok(e)
     }
 
@@ -345,7 +406,10 @@ impl Element {
         positive("truss EA", ea)?;
         crate::section::non_negative("truss mass per length", rho_a)?;
         Ok(Self::new(
-            Kind::Truss { l0, mass: rho_a * l0 },
+            Kind::Truss {
+                l0,
+                mass: rho_a * l0,
+            },
             vec![Slot::Position3, Slot::Position3],
             names(&["elongation"]),
             diag(&[ea / l0]),
@@ -375,16 +439,28 @@ impl Element {
     /// A spatial point mass.
     pub fn point_mass(m: f64) -> Result<Self, ElementError> {
         positive("point mass", m)?;
-        Ok(Self::new(Kind::PointMass { m }, vec![Slot::Position3], vec![], DMatrix::zeros(0, 0)))
+        Ok(Self::new(
+            Kind::PointMass { m },
+            vec![Slot::Position3],
+            vec![],
+            DMatrix::zeros(0, 0),
+        ))
     }
 
     /// A rigid body on a position + orientation node: mass `m`, centre of mass
     /// `c` and inertia tensor `j` about the centre of mass, both in the body frame
     /// `r0` (columns: body axes in the global frame at the initial configuration).
-    pub fn rigid_body(m: f64, c: [f64; 3], j: [[f64; 3]; 3], r0: [[f64; 3]; 3]) -> Result<Self, ElementError> {
+    pub fn rigid_body(
+        m: f64,
+        c: [f64; 3],
+        j: [[f64; 3]; 3],
+        r0: [[f64; 3]; 3],
+    ) -> Result<Self, ElementError> {
         positive("rigid body mass", m)?;
         let jm = Matrix3::from_fn(|a, b| j[a][b]);
-        if (jm - jm.transpose()).norm() > 1e-12 * jm.norm() || jm.symmetric_eigenvalues().min() < 0.0 {
+        if (jm - jm.transpose()).norm() > 1e-12 * jm.norm()
+            || jm.symmetric_eigenvalues().min() < 0.0
+        {
             return Err(ElementError::InvalidProperty {
                 what: "rigid body inertia tensor".into(),
                 value: jm.symmetric_eigenvalues().min(),
@@ -614,7 +690,13 @@ impl Element {
     }
 
     /// ε = D(x) and D,x (row-major n_ε × n_x).
-    pub fn deformations_and_jacobian(&self, x: &[f64], prev: Option<&[f64]>, eps: &mut [f64], jac: &mut [f64]) {
+    pub fn deformations_and_jacobian(
+        &self,
+        x: &[f64],
+        prev: Option<&[f64]>,
+        eps: &mut [f64],
+        jac: &mut [f64],
+    ) {
         let nx = self.n_x();
         macro_rules! go {
             ($k:expr, $nx:literal, $ne:literal) => {{
@@ -770,7 +852,10 @@ fn force_derivatives<I: InertiaForce, const N: usize>(
         let xdd1: [Dual<f64, 1>; 14 + MAX_MODES] =
             std::array::from_fn(|i| Dual::constant(if i < n { xdd[i] } else { 0.0 }));
         let xd1: [Dual<f64, 1>; 14 + MAX_MODES] = std::array::from_fn(|i| {
-            Dual::new(if i < n { xd[i] } else { 0.0 }, [if i == c { 1.0 } else { 0.0 }])
+            Dual::new(
+                if i < n { xd[i] } else { 0.0 },
+                [if i == c { 1.0 } else { 0.0 }],
+            )
         });
         inertia.force_generic(&x1, &xd1, &xdd1, &mut o1);
         for r in 0..n {
@@ -787,7 +872,10 @@ impl Element {
         out[..n * n].fill(0.0);
         match &self.kind {
             Kind::PlanarBeam(_, Some(i)) => i.mass(x, out),
-            Kind::TwoNode { inertia: Some(i), .. } | Kind::RigidBody(i) => i.mass(x, out),
+            Kind::TwoNode {
+                inertia: Some(i), ..
+            }
+            | Kind::RigidBody(i) => i.mass(x, out),
             Kind::PlanarTruss { mass, .. } | Kind::Truss { mass, .. } => {
                 let d = n / 2;
                 for a in 0..d {
@@ -818,8 +906,14 @@ impl Element {
         let n = self.n_x();
         match &self.kind {
             Kind::PlanarBeam(_, Some(i)) => i.force(x, xd, xdd, out),
-            Kind::TwoNode { inertia: Some(i), .. } | Kind::RigidBody(i) => i.force(x, xd, xdd, out),
-            Kind::PlanarTruss { .. } | Kind::Truss { .. } | Kind::PlanarMass { .. } | Kind::PointMass { .. } => {
+            Kind::TwoNode {
+                inertia: Some(i), ..
+            }
+            | Kind::RigidBody(i) => i.force(x, xd, xdd, out),
+            Kind::PlanarTruss { .. }
+            | Kind::Truss { .. }
+            | Kind::PlanarMass { .. }
+            | Kind::PointMass { .. } => {
                 // constant mass matrix: h = 0
                 let mut m = [0.0; 36];
                 self.mass_matrix(x, &mut m);
@@ -849,8 +943,12 @@ impl Element {
     ) {
         let n = self.n_x();
         match &self.kind {
-            Kind::PlanarBeam(_, Some(i)) => force_derivatives::<_, 6>(i, n, x, xd, xdd, dfdx, dfdxd),
-            Kind::TwoNode { inertia: Some(i), .. } => force_derivatives::<_, 14>(i, n, x, xd, xdd, dfdx, dfdxd),
+            Kind::PlanarBeam(_, Some(i)) => {
+                force_derivatives::<_, 6>(i, n, x, xd, xdd, dfdx, dfdxd)
+            }
+            Kind::TwoNode {
+                inertia: Some(i), ..
+            } => force_derivatives::<_, 14>(i, n, x, xd, xdd, dfdx, dfdxd),
             Kind::RigidBody(i) => force_derivatives::<_, 7>(i, n, x, xd, xdd, dfdx, dfdxd),
             _ => {
                 dfdx[..n * n].fill(0.0);
@@ -863,8 +961,14 @@ impl Element {
     pub fn kinetic_energy(&self, x: &[f64], xd: &[f64]) -> f64 {
         match &self.kind {
             Kind::PlanarBeam(_, Some(i)) => i.kinetic_energy(x, xd),
-            Kind::TwoNode { inertia: Some(i), .. } | Kind::RigidBody(i) => i.kinetic_energy(x, xd),
-            Kind::PlanarTruss { .. } | Kind::Truss { .. } | Kind::PlanarMass { .. } | Kind::PointMass { .. } => {
+            Kind::TwoNode {
+                inertia: Some(i), ..
+            }
+            | Kind::RigidBody(i) => i.kinetic_energy(x, xd),
+            Kind::PlanarTruss { .. }
+            | Kind::Truss { .. }
+            | Kind::PlanarMass { .. }
+            | Kind::PointMass { .. } => {
                 let n = self.n_x();
                 let mut m = [0.0; 36];
                 self.mass_matrix(x, &mut m);
@@ -887,10 +991,20 @@ impl Element {
         let n = self.n_x();
         match &self.kind {
             Kind::PlanarBeam(_, Some(i)) => i.gravity(x, g, out),
-            Kind::TwoNode { inertia: Some(i), .. } | Kind::RigidBody(i) => i.gravity(x, g, out),
-            Kind::PlanarTruss { .. } | Kind::Truss { .. } | Kind::PlanarMass { .. } | Kind::PointMass { .. } => {
+            Kind::TwoNode {
+                inertia: Some(i), ..
+            }
+            | Kind::RigidBody(i) => i.gravity(x, g, out),
+            Kind::PlanarTruss { .. }
+            | Kind::Truss { .. }
+            | Kind::PlanarMass { .. }
+            | Kind::PointMass { .. } => {
                 let mut xg = [0.0; 6];
-                let dim = if matches!(self.kind, Kind::Truss { .. } | Kind::PointMass { .. }) { 3 } else { 2 };
+                let dim = if matches!(self.kind, Kind::Truss { .. } | Kind::PointMass { .. }) {
+                    3
+                } else {
+                    2
+                };
                 let mut i = 0;
                 for s in &self.slots {
                     if matches!(s, Slot::Position2 | Slot::Position3) {
@@ -928,7 +1042,9 @@ impl Element {
         }
         match &self.kind {
             Kind::PlanarBeam(_, Some(i)) => go!(i, 6),
-            Kind::TwoNode { inertia: Some(i), .. } => go!(i, 14),
+            Kind::TwoNode {
+                inertia: Some(i), ..
+            } => go!(i, 14),
             Kind::RigidBody(i) => go!(i, 7),
             _ => {}
         }

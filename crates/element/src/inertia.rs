@@ -1,5 +1,5 @@
 //! Co-rotational inertia of one- and two-node elements: T = ½ ẋᵀ Bᵀ M̄ B ẋ
-//! (thesis (2.34), (3.30)), the mass matrix M = [B; I]ᵀ M̄ [B; I] (3.31) and the
+//! (thesis (2.34), (3.30)), the mass matrix M = \[B; I\]ᵀ M̄ \[B; I\] (3.31) and the
 //! inertia forces M ẍ + h with h of (2.40a)/(3.34b).
 //!
 //! One code path serves the spatial beam (M̄ its 12×12 consistent mass), the
@@ -58,7 +58,9 @@ pub(crate) struct SpatialInertia {
 
 fn mat34_scaled<T: Real>(a: &Mat3<T>, l: &[[T; 4]; 3], s: f64) -> [[T; 4]; 3] {
     std::array::from_fn(|i| {
-        std::array::from_fn(|j| (a.0[i][0] * l[0][j] + a.0[i][1] * l[1][j] + a.0[i][2] * l[2][j]) * s)
+        std::array::from_fn(|j| {
+            (a.0[i][0] * l[0][j] + a.0[i][1] * l[1][j] + a.0[i][2] * l[2][j]) * s
+        })
     })
 }
 
@@ -122,7 +124,8 @@ impl SpatialInertia {
     fn apply_t_add<T: Real>(&self, b: &SpatialBlocks<T>, u: &[T], s: f64, out: &mut [T]) {
         for n in 0..self.nodes {
             let o = 7 * n;
-            let f = b.ft.tr_mul_vec(&Vec3([u[6 * n], u[6 * n + 1], u[6 * n + 2]]));
+            let f =
+                b.ft.tr_mul_vec(&Vec3([u[6 * n], u[6 * n + 1], u[6 * n + 2]]));
             let m = m34_tr_vec(&b.g[n], &u[6 * n + 3..6 * n + 6]);
             for i in 0..3 {
                 out[o + i] += f.0[i] * s;
@@ -140,8 +143,13 @@ impl SpatialInertia {
         let nw = self.mbar.nrows();
         let b = self.blocks(x);
         // Ḃ by a dual pass along ẋ
-        let xe: [Dual<T, 1>; 14] =
-            std::array::from_fn(|i| if i < nxn { Dual::new(x[i], [xd[i]]) } else { Dual::constant(T::zero()) });
+        let xe: [Dual<T, 1>; 14] = std::array::from_fn(|i| {
+            if i < nxn {
+                Dual::new(x[i], [xd[i]])
+            } else {
+                Dual::constant(T::zero())
+            }
+        });
         let bd = self.blocks(&xe);
         let bdot = SpatialBlocks {
             ft: Mat3(bd.ft.0.map(|r| r.map(|v| v.eps[0]))),
@@ -192,8 +200,13 @@ impl SpatialInertia {
             }
         });
         let bl = self.blocks(&xl);
-        let xdl: [Dual<T, 8>; 14] =
-            std::array::from_fn(|i| if i < nxn { Dual::constant(xd[i]) } else { Dual::constant(T::zero()) });
+        let xdl: [Dual<T, 8>; 14] = std::array::from_fn(|i| {
+            if i < nxn {
+                Dual::constant(xd[i])
+            } else {
+                Dual::constant(T::zero())
+            }
+        });
         let mut v = [Dual::<T, 8>::constant(T::zero()); 12];
         self.apply(&bl, &xdl, &mut v);
         let mut phi = Dual::<T, 8>::constant(T::zero());
@@ -241,7 +254,7 @@ impl SpatialInertia {
         }
     }
 
-    /// The mass matrix M = [B; I]ᵀ M̄ [B; I] (row-major, n × n with
+    /// The mass matrix M = \[B; I\]ᵀ M̄ \[B; I\] (row-major, n × n with
     /// n = 7·nodes + modes).
     pub fn mass(&self, x: &[f64], out: &mut [f64]) {
         let nxn = self.nx_nodes();
@@ -379,8 +392,13 @@ impl PlanarInertia {
         let betad = self.angle(xd) - self.beta0;
         // Ḃ = β̇ ∂B/∂β; ∂B/∂β ẋ = B(β + π/2)-like rotation: compute with a dual.
         let bd = Dual::<T, 1>::new(beta, [betad]);
-        let xdd1: [Dual<T, 1>; 6] =
-            std::array::from_fn(|i| if i < n { Dual::constant(xd[i]) } else { Dual::constant(T::zero()) });
+        let xdd1: [Dual<T, 1>; 6] = std::array::from_fn(|i| {
+            if i < n {
+                Dual::constant(xd[i])
+            } else {
+                Dual::constant(T::zero())
+            }
+        });
         let mut vdual = [Dual::<T, 1>::constant(T::zero()); 6];
         self.apply(bd, &xdd1, &mut vdual);
         let mut w = [T::zero(); 6];

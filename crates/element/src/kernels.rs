@@ -175,7 +175,10 @@ pub(crate) struct SpatialHingeKernel {
 impl SpatialHingeKernel {
     /// The angle in (−π, π] from primal values only.
     pub fn principal_angle(r0: &[[f64; 3]; 3], x: &[f64; 8]) -> f64 {
-        let k = SpatialHingeKernel { r0: *r0, offset: 0.0 };
+        let k = SpatialHingeKernel {
+            r0: *r0,
+            offset: 0.0,
+        };
         k.eval(x)[0]
     }
     /// The 2πk that puts the principal angle `a` closest to `prev`.

@@ -42,8 +42,8 @@ mod section;
 mod superelement;
 
 pub use beam_matrices::{
-    equivalent_stiffness, planar_beam_m_bar, planar_beam_s_bar, shear_parameter, spatial_a_diag, spatial_beam_m_bar,
-    spatial_beam_s_bar,
+    equivalent_stiffness, planar_beam_m_bar, planar_beam_s_bar, shear_parameter, spatial_a_diag,
+    spatial_beam_m_bar, spatial_beam_s_bar,
 };
 pub use element::{frame_from_axis, BeamOptions, Element, Slot};
 pub use inertia::{VelocityTransform, MAX_MODES};

@@ -10,11 +10,11 @@ use serde::{Deserialize, Serialize};
 /// A linear elastic isotropic material.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Material {
-    /// Young's modulus E [Pa].
+    /// Young's modulus E (Pa).
     pub e: f64,
-    /// Shear modulus G [Pa].
+    /// Shear modulus G (Pa).
     pub g: f64,
-    /// Density ρ [kg/m³].
+    /// Density ρ (kg/m³).
     pub rho: f64,
 }
 
@@ -42,13 +42,13 @@ impl Material {
 /// Cross-section properties used by the beam elements.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SectionProperties {
-    /// Area A [m²].
+    /// Area A (m²).
     pub area: f64,
-    /// Second moment of area about local y, Iy [m⁴] (bending in the xz-plane).
+    /// Second moment of area about local y, Iy (m⁴) (bending in the xz-plane).
     pub iy: f64,
-    /// Second moment of area about local z, Iz [m⁴] (bending in the xy-plane).
+    /// Second moment of area about local z, Iz (m⁴) (bending in the xy-plane).
     pub iz: f64,
-    /// Torsion constant J [m⁴] (St Venant).
+    /// Torsion constant J (m⁴) (St Venant).
     pub j: f64,
     /// Shear correction factor for shear in y (κy); `f64::INFINITY` gives Euler–Bernoulli.
     pub ky: f64,
@@ -91,21 +91,21 @@ impl SectionProperties {
 pub enum SectionShape {
     /// A solid rectangle with side `by` along local y and `bz` along local z.
     Rectangle {
-        /// Side along local y [m].
+        /// Side along local y (m).
         by: f64,
-        /// Side along local z [m].
+        /// Side along local z (m).
         bz: f64,
     },
     /// A solid circle.
     Circle {
-        /// Diameter [m].
+        /// Diameter (m).
         d: f64,
     },
     /// A circular tube.
     Tube {
-        /// Outer diameter [m].
+        /// Outer diameter (m).
         d_outer: f64,
-        /// Inner diameter [m].
+        /// Inner diameter (m).
         d_inner: f64,
     },
     /// Properties given directly.
@@ -179,7 +179,7 @@ impl SectionShape {
 
 /// St Venant torsion constant of a solid rectangle a × b from the standard
 /// series (Timoshenko & Goodier, *Theory of Elasticity*, §109):
-/// J = (a b³/3) [1 − (192/π⁵)(b/a) Σ_{n odd} tanh(nπa/(2b))/n⁵], a ≥ b.
+/// J = (a b³/3) (1 − (192/π⁵)(b/a) Σ_{n odd} tanh(nπa/(2b))/n⁵), a ≥ b.
 /// Summed until the terms are below 1e-17 relative.
 pub fn rectangle_torsion_constant(s1: f64, s2: f64) -> f64 {
     let (a, b) = if s1 >= s2 { (s1, s2) } else { (s2, s1) };

@@ -29,7 +29,7 @@ pub enum ModeKind {
     },
     /// A fixed-interface normal mode with its frequency.
     Normal {
-        /// Eigenfrequency with both interfaces fixed [Hz].
+        /// Eigenfrequency with both interfaces fixed (Hz).
         frequency_hz: f64,
     },
 }
@@ -51,7 +51,7 @@ pub struct Provenance {
 ///   q-side ones, then the fixed-interface normal modes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LinearSuperelement {
-    /// Reference length |q − p| [m].
+    /// Reference length |q − p| (m).
     pub l0: f64,
     /// Initial orientation R0: its columns are the element's x, y, z axes in the
     /// global frame (x from p to q).
@@ -108,7 +108,11 @@ impl LinearSuperelement {
         m_bar: &DMatrix<f64>,
         modes: Vec<ModeKind>,
     ) -> Self {
-        let rows = |m: &DMatrix<f64>| (0..m.nrows()).map(|i| m.row(i).iter().copied().collect()).collect();
+        let rows = |m: &DMatrix<f64>| {
+            (0..m.nrows())
+                .map(|i| m.row(i).iter().copied().collect())
+                .collect()
+        };
         Self {
             l0,
             r0,
@@ -141,7 +145,9 @@ impl LinearSuperelement {
             for (i, r) in rows.iter().enumerate() {
                 for (j, v) in r.iter().enumerate() {
                     if !v.is_finite() {
-                        return Err(ElementError::Superelement(format!("{name}[{i}][{j}] is {v}")));
+                        return Err(ElementError::Superelement(format!(
+                            "{name}[{i}][{j}] is {v}"
+                        )));
                     }
                     if (v - rows[j][i]).abs() > 1e-9 * scale {
                         return Err(ElementError::Superelement(format!(
@@ -167,8 +173,12 @@ impl LinearSuperelement {
             ));
         }
         let r = nalgebra::Matrix3::from_fn(|i, j| self.r0[i][j]);
-        if (r.transpose() * r - nalgebra::Matrix3::identity()).norm() > 1e-9 || r.determinant() < 0.0 {
-            return Err(ElementError::Superelement("R0 is not a rotation matrix".into()));
+        if (r.transpose() * r - nalgebra::Matrix3::identity()).norm() > 1e-9
+            || r.determinant() < 0.0
+        {
+            return Err(ElementError::Superelement(
+                "R0 is not a rotation matrix".into(),
+            ));
         }
         Ok(())
     }

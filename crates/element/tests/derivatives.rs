@@ -49,7 +49,10 @@ fn deformation_jacobian_matches_central_differences() {
             let mut j = vec![0.0; ne * nx];
             e.deformations_and_jacobian(&x, None, &mut eps, &mut j);
             let plain = eps_of(&e, &x, None);
-            assert!(rel_err(&eps, &plain) < 1e-14, "{name}: ε differs between the two entry points");
+            assert!(
+                rel_err(&eps, &plain) < 1e-14,
+                "{name}: ε differs between the two entry points"
+            );
             let mut fd = vec![0.0; ne * nx];
             for c in 0..nx {
                 let u = unit(nx, c);
@@ -84,7 +87,11 @@ fn directional_second_derivative_matches_differences_of_the_jacobian() {
             let jp = jac_of(&e, &shifted(&x, &a, h));
             let jm = jac_of(&e, &shifted(&x, &a, -h));
             let fd: Vec<f64> = (0..ne)
-                .map(|rr| (0..nx).map(|c| (jp[rr * nx + c] - jm[rr * nx + c]) / (2.0 * h) * b[c]).sum())
+                .map(|rr| {
+                    (0..nx)
+                        .map(|c| (jp[rr * nx + c] - jm[rr * nx + c]) / (2.0 * h) * b[c])
+                        .sum()
+                })
                 .collect();
             let err = rel_err(&d2, &fd);
             assert!(err < TOL, "{name}: D,xx[a,b] relative error {err:e}");
@@ -102,12 +109,16 @@ fn weighted_hessian_matches_differences_of_the_weighted_gradient() {
         }
         let x = random_x(&mut r, &e);
         let (nx, ne) = (e.n_x(), e.n_eps());
-        let w: Vec<f64> = (0..ne).map(|i| 1.0 + 0.5 * i as f64 * if i % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        let w: Vec<f64> = (0..ne)
+            .map(|i| 1.0 + 0.5 * i as f64 * if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
         let mut hs = vec![0.0; nx * nx];
         e.deformation_weighted_hessian(&x, &w, &mut hs);
         let grad = |x: &[f64]| -> Vec<f64> {
             let j = jac_of(&e, x);
-            (0..nx).map(|c| (0..ne).map(|rr| w[rr] * j[rr * nx + c]).sum()).collect()
+            (0..nx)
+                .map(|c| (0..ne).map(|rr| w[rr] * j[rr * nx + c]).sum())
+                .collect()
         };
         let mut fd = vec![0.0; nx * nx];
         for c in 0..nx {
@@ -123,7 +134,9 @@ fn weighted_hessian_matches_differences_of_the_weighted_gradient() {
         // symmetric
         for i in 0..nx {
             for j in 0..nx {
-                assert!((hs[i * nx + j] - hs[j * nx + i]).abs() <= 1e-12 * max_abs(&hs).max(1e-300));
+                assert!(
+                    (hs[i * nx + j] - hs[j * nx + i]).abs() <= 1e-12 * max_abs(&hs).max(1e-300)
+                );
             }
         }
     }
@@ -135,7 +148,9 @@ fn dt_dxd(e: &Element, x: &[f64], xd: &[f64]) -> Vec<f64> {
     (0..n)
         .map(|c| {
             let u = unit(n, c);
-            (e.kinetic_energy(x, &shifted(xd, &u, 1.0)) - e.kinetic_energy(x, &shifted(xd, &u, -1.0))) / 2.0
+            (e.kinetic_energy(x, &shifted(xd, &u, 1.0))
+                - e.kinetic_energy(x, &shifted(xd, &u, -1.0)))
+                / 2.0
         })
         .collect()
 }
@@ -153,11 +168,16 @@ fn mass_matrix_is_the_hessian_of_the_kinetic_energy() {
             let n = e.n_x();
             let mut m = vec![0.0; n * n];
             e.mass_matrix(&x, &mut m);
-            let mxd: Vec<f64> = (0..n).map(|i| (0..n).map(|j| m[i * n + j] * xd[j]).sum()).collect();
+            let mxd: Vec<f64> = (0..n)
+                .map(|i| (0..n).map(|j| m[i * n + j] * xd[j]).sum())
+                .collect();
             let err = rel_err(&mxd, &dt_dxd(&e, &x, &xd));
             assert!(err < 1e-12, "{name}: M ẋ vs ∂T/∂ẋ {err:e}");
             let t2: f64 = (0..n).map(|i| xd[i] * mxd[i]).sum();
-            assert!((t2 - 2.0 * e.kinetic_energy(&x, &xd)).abs() < 1e-12 * t2.abs().max(1e-30), "{name}");
+            assert!(
+                (t2 - 2.0 * e.kinetic_energy(&x, &xd)).abs() < 1e-12 * t2.abs().max(1e-30),
+                "{name}"
+            );
         }
     }
 }
@@ -179,7 +199,9 @@ fn inertia_force_satisfies_lagranges_equations() {
             let xd = random_xd(&mut r, &e, &x);
             let xdd = random_x(&mut r, &e);
             let at = |t: f64| {
-                let xt: Vec<f64> = (0..n).map(|i| x[i] + t * xd[i] + 0.5 * t * t * xdd[i]).collect();
+                let xt: Vec<f64> = (0..n)
+                    .map(|i| x[i] + t * xd[i] + 0.5 * t * t * xdd[i])
+                    .collect();
                 let vt: Vec<f64> = (0..n).map(|i| xd[i] + t * xdd[i]).collect();
                 dt_dxd(&e, &xt, &vt)
             };
@@ -187,7 +209,8 @@ fn inertia_force_satisfies_lagranges_equations() {
             let mut lag = vec![0.0; n];
             for i in 0..n {
                 let u = unit(n, i);
-                let dtdx = (e.kinetic_energy(&shifted(&x, &u, H), &xd) - e.kinetic_energy(&shifted(&x, &u, -H), &xd))
+                let dtdx = (e.kinetic_energy(&shifted(&x, &u, H), &xd)
+                    - e.kinetic_energy(&shifted(&x, &u, -H), &xd))
                     / (2.0 * H);
                 lag[i] = (pp[i] - pm[i]) / (2.0 * ht) - dtdx;
             }

@@ -197,7 +197,7 @@ impl EulerParameters {
         Self([c, axis[0] * s, axis[1] * s, axis[2] * s])
     }
 
-    /// The rotation as (unit axis, angle in [0, π]); the axis is x for the identity.
+    /// The rotation as (unit axis, angle in 0..=π); the axis is x for the identity.
     pub fn to_axis_angle(&self) -> (Unit<Vector3<f64>>, f64) {
         let e = self.normalized().unwrap_or_default();
         let mut l = e.0;
@@ -227,7 +227,7 @@ impl EulerParameters {
         Self([half.cos(), rv[0] * k, rv[1] * k, rv[2] * k])
     }
 
-    /// The rotation vector θ n with θ ∈ [0, π] (logarithmic map).
+    /// The rotation vector θ n with θ ∈ 0..=π (logarithmic map).
     pub fn to_rotation_vector(&self) -> Vector3<f64> {
         let (axis, angle) = self.to_axis_angle();
         axis.into_inner() * angle
@@ -242,7 +242,7 @@ impl EulerParameters {
         z.compose(&y).compose(&x)
     }
 
-    /// ZYX angles (yaw, pitch, roll) for output, with pitch in [−π/2, π/2]. At
+    /// ZYX angles (yaw, pitch, roll) for output, with pitch in −π/2..=π/2. At
     /// gimbal lock (|pitch| = π/2) the roll is set to zero and the yaw carries
     /// the whole remaining rotation.
     pub fn to_zyx(&self) -> (f64, f64, f64) {

@@ -11,11 +11,7 @@ use flexmb_dual::{Mat3, Real, Vec3};
 #[inline]
 pub fn lambda_mat<T: Real>(l: &[T; 4]) -> [[T; 4]; 3] {
     let [l0, l1, l2, l3] = *l;
-    [
-        [-l1, l0, -l3, l2],
-        [-l2, l3, l0, -l1],
-        [-l3, -l2, l1, l0],
-    ]
+    [[-l1, l0, -l3, l2], [-l2, l3, l0, -l1], [-l3, -l2, l1, l0]]
 }
 
 /// Λ̄(λ) = RᵀΛ of thesis Eq. (2.33) (on the unit sphere): ω̄ = 2 Λ̄ λ̇ is the
@@ -25,11 +21,7 @@ pub fn lambda_mat<T: Real>(l: &[T; 4]) -> [[T; 4]; 3] {
 #[inline]
 pub fn lambda_bar_mat<T: Real>(l: &[T; 4]) -> [[T; 4]; 3] {
     let [l0, l1, l2, l3] = *l;
-    [
-        [-l1, l0, l3, -l2],
-        [-l2, -l3, l0, l1],
-        [-l3, l2, -l1, l0],
-    ]
+    [[-l1, l0, l3, -l2], [-l2, -l3, l0, l1], [-l3, l2, -l1, l0]]
 }
 
 /// R(λ) = Λ Λ̄ᵀ, the homogeneous quadratic form of the rotation matrix
@@ -40,9 +32,21 @@ pub fn rotation<T: Real>(l: &[T; 4]) -> Mat3<T> {
     let (a, b, c, d) = (l0 * l0, l1 * l1, l2 * l2, l3 * l3);
     let two = |x: T| x * 2.0;
     Mat3([
-        [a + b - c - d, two(l1 * l2 - l0 * l3), two(l1 * l3 + l0 * l2)],
-        [two(l1 * l2 + l0 * l3), a - b + c - d, two(l2 * l3 - l0 * l1)],
-        [two(l1 * l3 - l0 * l2), two(l2 * l3 + l0 * l1), a - b - c + d],
+        [
+            a + b - c - d,
+            two(l1 * l2 - l0 * l3),
+            two(l1 * l3 + l0 * l2),
+        ],
+        [
+            two(l1 * l2 + l0 * l3),
+            a - b + c - d,
+            two(l2 * l3 - l0 * l1),
+        ],
+        [
+            two(l1 * l3 - l0 * l2),
+            two(l2 * l3 + l0 * l1),
+            a - b - c + d,
+        ],
     ])
 }
 

@@ -49,12 +49,19 @@ fn omega_matches_differences_of_r() {
     let mut rng = StdRng::seed_from_u64(3);
     for _ in 0..50 {
         let l = random_lambda(&mut rng);
-        let w = Vector3::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0), 0.7);
+        let w = Vector3::new(
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-3.0..3.0),
+            0.7,
+        );
         let ld = l.lambda_dot_from_omega(&w);
         let h = 1e-6;
         let at = |t: f64| {
             let v = l.as_vector() + Vector4::from(ld) * t;
-            EulerParameters([v[0], v[1], v[2], v[3]]).normalized().unwrap().rotation_matrix()
+            EulerParameters([v[0], v[1], v[2], v[3]])
+                .normalized()
+                .unwrap()
+                .rotation_matrix()
         };
         let rdot = (at(h) - at(-h)) / (2.0 * h);
         let r = l.rotation_matrix();
@@ -119,7 +126,9 @@ fn conversions_round_trip_near_zero_pi_and_two_pi() {
         let back = EulerParameters::from_rotation_matrix(&r);
         assert!((back.rotation_matrix() - r).norm() < 1e-14, "angle {angle}");
         // λ equal up to sign
-        let d = (back.as_vector() - l.as_vector()).norm().min((back.as_vector() + l.as_vector()).norm());
+        let d = (back.as_vector() - l.as_vector())
+            .norm()
+            .min((back.as_vector() + l.as_vector()).norm());
         assert!(d < 1e-14, "angle {angle}: {d}");
         // rotation vector → λ → rotation vector gives the same rotation
         let rv = l.to_rotation_vector();
@@ -196,7 +205,9 @@ fn d_average_matches_central_differences() {
     for _ in 0..30 {
         let p = random_lambda(&mut rng);
         let dq: [f64; 4] = std::array::from_fn(|_| rng.random_range(-0.2..0.2));
-        let q = EulerParameters(std::array::from_fn(|i| p.0[i] + dq[i])).normalized().unwrap();
+        let q = EulerParameters(std::array::from_fn(|i| p.0[i] + dq[i]))
+            .normalized()
+            .unwrap();
         let (dp, dqm) = EulerParameters::d_average(&p, &q);
         let h = 1e-6;
         for j in 0..4 {
@@ -220,5 +231,7 @@ fn d_average_matches_central_differences() {
 #[test]
 fn normalization_rejects_zero_and_nan() {
     assert!(EulerParameters([0.0; 4]).normalized().is_none());
-    assert!(EulerParameters([f64::NAN, 1.0, 0.0, 0.0]).normalized().is_none());
+    assert!(EulerParameters([f64::NAN, 1.0, 0.0, 0.0])
+        .normalized()
+        .is_none());
 }

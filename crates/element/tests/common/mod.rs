@@ -18,7 +18,11 @@ pub fn steel() -> Material {
 
 pub fn random_unit(rng: &mut StdRng) -> Unit<Vector3<f64>> {
     loop {
-        let v = Vector3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let v = Vector3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
         if v.norm() > 0.1 {
             return Unit::new_normalize(v);
         }
@@ -38,7 +42,11 @@ pub fn random_spd(rng: &mut StdRng, n: usize, scale: f64) -> DMatrix<f64> {
 }
 
 /// A superelement with random S̄, M̄ and `k` modes (one p-side, one q-side, rest normal).
-pub fn random_superelement(rng: &mut StdRng, k: usize, transform: VelocityTransform) -> (Element, LinearSuperelement) {
+pub fn random_superelement(
+    rng: &mut StdRng,
+    k: usize,
+    transform: VelocityTransform,
+) -> (Element, LinearSuperelement) {
     let l0 = 0.3;
     let r0 = frame_from_axis(&[0.3, 0.1, -0.2], &[0.0, 0.0, 1.0]).unwrap();
     let mut modes = vec![];
@@ -46,10 +54,16 @@ pub fn random_superelement(rng: &mut StdRng, k: usize, transform: VelocityTransf
         modes.push(match i {
             0 => ModeKind::Warping(Side::P),
             1 => ModeKind::Warping(Side::Q),
-            _ => ModeKind::Normal { frequency_hz: 100.0 * i as f64 },
+            _ => ModeKind::Normal {
+                frequency_hz: 100.0 * i as f64,
+            },
         });
     }
-    let beam = spatial_beam_m_bar(&steel(), &SectionShape::Circle { d: 0.02 }.properties(0.3).unwrap(), l0);
+    let beam = spatial_beam_m_bar(
+        &steel(),
+        &SectionShape::Circle { d: 0.02 }.properties(0.3).unwrap(),
+        l0,
+    );
     let mut mbar = DMatrix::from_iterator(12, 12, beam.iter().copied()).resize(12 + k, 12 + k, 0.0);
     let extra = random_spd(rng, 12 + k, 0.05);
     mbar += extra;
@@ -61,7 +75,10 @@ pub fn random_superelement(rng: &mut StdRng, k: usize, transform: VelocityTransf
 /// The catalogue of elements under test, with a name.
 pub fn catalogue(rng: &mut StdRng) -> Vec<(String, Element)> {
     let mat = steel();
-    let rect = SectionShape::Rectangle { by: 0.03, bz: 0.004 };
+    let rect = SectionShape::Rectangle {
+        by: 0.03,
+        bz: 0.004,
+    };
     let mut v = vec![];
     for (tag, opts) in [
         ("", BeamOptions::default()),
@@ -81,7 +98,15 @@ pub fn catalogue(rng: &mut StdRng) -> Vec<(String, Element)> {
         ));
         v.push((
             format!("spatial beam{tag}"),
-            Element::beam([0.1, 0.2, -0.1], [0.3, 0.1, 0.05], [0.0, 0.0, 1.0], &mat, &rect, &opts).unwrap(),
+            Element::beam(
+                [0.1, 0.2, -0.1],
+                [0.3, 0.1, 0.05],
+                [0.0, 0.0, 1.0],
+                &mat,
+                &rect,
+                &opts,
+            )
+            .unwrap(),
         ));
     }
     v.push((
@@ -99,11 +124,23 @@ pub fn catalogue(rng: &mut StdRng) -> Vec<(String, Element)> {
         )
         .unwrap(),
     ));
-    v.push(("planar truss".into(), Element::planar_truss([0.0, 0.0], [0.3, 0.1], 1e6, 2.0).unwrap()));
+    v.push((
+        "planar truss".into(),
+        Element::planar_truss([0.0, 0.0], [0.3, 0.1], 1e6, 2.0).unwrap(),
+    ));
     v.push(("planar hinge".into(), Element::planar_hinge(3.0).unwrap()));
-    v.push(("planar mass".into(), Element::planar_mass(2.0, Some(0.1)).unwrap()));
-    v.push(("truss".into(), Element::truss([0.0; 3], [0.3, 0.1, 0.2], 1e6, 2.0).unwrap()));
-    v.push(("hinge".into(), Element::hinge([0.2, 0.5, 1.0], 3.0, 1e3).unwrap()));
+    v.push((
+        "planar mass".into(),
+        Element::planar_mass(2.0, Some(0.1)).unwrap(),
+    ));
+    v.push((
+        "truss".into(),
+        Element::truss([0.0; 3], [0.3, 0.1, 0.2], 1e6, 2.0).unwrap(),
+    ));
+    v.push((
+        "hinge".into(),
+        Element::hinge([0.2, 0.5, 1.0], 3.0, 1e3).unwrap(),
+    ));
     v.push(("point mass".into(), Element::point_mass(1.5).unwrap()));
     let r0 = frame_from_axis(&[1.0, 1.0, 0.0], &[0.0, 0.0, 1.0]).unwrap();
     v.push((
@@ -117,8 +154,15 @@ pub fn catalogue(rng: &mut StdRng) -> Vec<(String, Element)> {
         .unwrap(),
     ));
     v.push(("normalization".into(), Element::normalization()));
-    for (t, tr) in [("B1", VelocityTransform::B1), ("B2", VelocityTransform::B2), ("B3", VelocityTransform::B3)] {
-        v.push((format!("superelement {t}"), random_superelement(rng, 3, tr).0));
+    for (t, tr) in [
+        ("B1", VelocityTransform::B1),
+        ("B2", VelocityTransform::B2),
+        ("B3", VelocityTransform::B3),
+    ] {
+        v.push((
+            format!("superelement {t}"),
+            random_superelement(rng, 3, tr).0,
+        ));
     }
     v
 }
@@ -154,7 +198,11 @@ pub fn random_xd(rng: &mut StdRng, e: &Element, x: &[f64]) -> Vec<f64> {
         match s {
             Slot::Orientation => {
                 let l = EulerParameters([x[i], x[i + 1], x[i + 2], x[i + 3]]);
-                let w = Vector3::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0));
+                let w = Vector3::new(
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-3.0..3.0),
+                );
                 v.extend(l.lambda_dot_from_omega(&w));
             }
             _ => {
