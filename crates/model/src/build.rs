@@ -1,0 +1,676 @@
+//! Validation of a scene and its assembly into a [`Mechanism`].
+
+use crate::mechanism::*;
+use crate::scene::*;
+use crate::{ModelError, TimeFunction};
+use flexmb_element::{BeamOptions, Element, LinearSuperelement, Material, SectionShape};
+use flexmb_rotation::EulerParameters;
+use nalgebra::Vector3;
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+
+/// Where a slot of an element attaches.
+#[derive(Clone, Debug)]
+enum Attach {
+    Pos(String),
+    Orient(String),
+    Group(String),
+}
+
+struct Expanded {
+    id: String,
+    group: String,
+    element: Element,
+    attach: Vec<Attach>,
+}
+
+fn finite_vec(ctx: &str, v: &[f64]) -> Result<(), ModelError> {
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        return Err(ModelError::invalid(
+            ctx,
+            format!("contains a non-finite value {x}"),
+        ));
+    }
+    Ok(())
+}
+
+fn closest<'a>(id: &str, candidates: impl Iterator<Item = &'a String>) -> String {
+    let mut best: Option<(usize, &str)> = None;
+    for c in candidates {
+        let d = edit_distance(id, c);
+        if best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, c));
+        }
+    }
+    match best {
+        Some((d, c)) if d <= 3 => format!(" (did you mean '{c}'?)"),
+        _ => String::new(),
+    }
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for i in 1..=a.len() {
+        let mut cur = vec![i; b.len() + 1];
+        for j in 1..=b.len() {
+            let c = if a[i - 1] == b[j - 1] { 0 } else { 1 };
+            cur[j] = (prev[j] + 1).min(cur[j - 1] + 1).min(prev[j - 1] + c);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// Assembles a scene. `base_dir` resolves relative superelement file paths.
+pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelError> {
+    let dim = scene.dimension;
+    let nd = match dim {
+        Dimension::Planar => 2,
+        Dimension::Spatial => 3,
+    };
+    // ---- nodes
+    let mut node_at: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let mut node_order: Vec<String> = vec![];
+    for n in &scene.nodes {
+        if n.id.is_empty() {
+            return Err(ModelError::invalid("node", "an empty id"));
+        }
+        if n.at.len() != nd {
+            return Err(ModelError::invalid(
+                format!("node '{}'", n.id),
+                format!(
+                    "position has {} components, a {dim:?} scene needs {nd}",
+                    n.at.len()
+                ),
+            ));
+        }
+        finite_vec(&format!("node '{}' position", n.id), &n.at)?;
+        if node_at.insert(n.id.clone(), n.at.clone()).is_some() {
+            return Err(ModelError::DuplicateId {
+                kind: "node",
+                id: n.id.clone(),
+            });
+        }
+        node_order.push(n.id.clone());
+    }
+    // ---- materials and sections
+    let mut materials = BTreeMap::new();
+    for (id, m) in &scene.materials {
+        let nu = m.nu.unwrap_or(0.3);
+        let mat = match m.g {
+            Some(g) => Material {
+                e: m.e,
+                g,
+                rho: m.rho,
+            },
+            None => Material::from_poisson(m.e, nu, m.rho),
+        };
+        mat.validate()
+            .map_err(|e| ModelError::invalid(format!("material '{id}'"), e.to_string()))?;
+        materials.insert(id.clone(), mat);
+    }
+    let sections: BTreeMap<String, SectionShape> = scene
+        .sections
+        .iter()
+        .map(|(id, s)| {
+            let shape = match s {
+                SectionSpec::Rectangle { by, bz } => SectionShape::Rectangle { by: *by, bz: *bz },
+                SectionSpec::Circle { d } => SectionShape::Circle { d: *d },
+                SectionSpec::Tube { d_outer, d_inner } => SectionShape::Tube {
+                    d_outer: *d_outer,
+                    d_inner: *d_inner,
+                },
+                SectionSpec::User(p) => SectionShape::User(*p),
+            };
+            shape
+                .properties(0.3)
+                .map(|_| (id.clone(), shape))
+                .map_err(|e| ModelError::invalid(format!("section '{id}'"), e.to_string()))
+        })
+        .collect::<Result<_, _>>()?;
+    let gravity = match &scene.gravity {
+        None => None,
+        Some(g) => {
+            if g.len() != nd {
+                return Err(ModelError::invalid(
+                    "gravity",
+                    format!("has {} components, expected {nd}", g.len()),
+                ));
+            }
+            finite_vec("gravity", g)?;
+            Some([g[0], g[1], if nd == 3 { g[2] } else { 0.0 }])
+        }
+    };
+    let node_ref = |id: &str,
+                    ctx: &str,
+                    node_at: &BTreeMap<String, Vec<f64>>|
+     -> Result<Vec<f64>, ModelError> {
+        node_at
+            .get(id)
+            .cloned()
+            .ok_or_else(|| ModelError::UnknownId {
+                kind: "node",
+                id: id.to_string(),
+                context: ctx.to_string(),
+                hint: closest(id, node_at.keys()),
+            })
+    };
+    // ---- elements (chains expanded)
+    let mut expanded: Vec<Expanded> = vec![];
+    let mut element_ids = HashMap::new();
+    let mut mode_groups: Vec<(String, usize)> = vec![];
+    for entry in &scene.elements {
+        let id = entry.id.clone();
+        if element_ids.insert(id.clone(), ()).is_some() {
+            return Err(ModelError::DuplicateId {
+                kind: "element",
+                id,
+            });
+        }
+        let ctx = format!("element '{id}'");
+        let wrap = |e: flexmb_element::ElementError| ModelError::Element {
+            id: id.clone(),
+            source: e,
+        };
+        if chain_n(&entry.kind) == 0 {
+            return Err(ModelError::invalid(ctx, "n must be at least 1"));
+        }
+        match &entry.kind {
+            ElementSpec::Beam(b) => {
+                let p = node_ref(&b.nodes.0, &ctx, &node_at)?;
+                let q = node_ref(&b.nodes.1, &ctx, &node_at)?;
+                let mat = *materials
+                    .get(&b.material)
+                    .ok_or_else(|| ModelError::UnknownId {
+                        kind: "material",
+                        id: b.material.clone(),
+                        context: ctx.clone(),
+                        hint: closest(&b.material, materials.keys()),
+                    })?;
+                let shape = *sections
+                    .get(&b.section)
+                    .ok_or_else(|| ModelError::UnknownId {
+                        kind: "section",
+                        id: b.section.clone(),
+                        context: ctx.clone(),
+                        hint: closest(&b.section, sections.keys()),
+                    })?;
+                let opts = BeamOptions {
+                    shortening: b.shortening,
+                    timoshenko: b.timoshenko,
+                    inertia: b.mass,
+                    velocity_transform: b.transform,
+                };
+                let chain = chain_nodes(&id, &b.nodes, &p, &q, b.n, &mut node_at, &mut node_order)?;
+                for (k, (a, bb)) in chain.iter().enumerate() {
+                    let (pa, pb) = (node_at[a].clone(), node_at[bb].clone());
+                    let eid = if b.n == 1 {
+                        id.clone()
+                    } else {
+                        format!("{id}.{}", k + 1)
+                    };
+                    let element = match dim {
+                        Dimension::Planar => Element::planar_beam(
+                            [pa[0], pa[1]],
+                            [pb[0], pb[1]],
+                            &mat,
+                            &shape,
+                            &opts,
+                        )
+                        .map_err(wrap)?,
+                        Dimension::Spatial => {
+                            let axis = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+                            let up = match &b.up {
+                                Some(u) => vec3(&ctx, "up", u)?,
+                                None => default_up(&axis),
+                            };
+                            Element::beam(
+                                [pa[0], pa[1], pa[2]],
+                                [pb[0], pb[1], pb[2]],
+                                up,
+                                &mat,
+                                &shape,
+                                &opts,
+                            )
+                            .map_err(wrap)?
+                        }
+                    };
+                    expanded.push(Expanded {
+                        id: eid,
+                        group: id.clone(),
+                        element,
+                        attach: vec![
+                            Attach::Pos(a.clone()),
+                            Attach::Orient(a.clone()),
+                            Attach::Pos(bb.clone()),
+                            Attach::Orient(bb.clone()),
+                        ],
+                    });
+                }
+            }
+            ElementSpec::Truss {
+                nodes,
+                ea,
+                mass_per_length,
+                n,
+            } => {
+                let p = node_ref(&nodes.0, &ctx, &node_at)?;
+                let q = node_ref(&nodes.1, &ctx, &node_at)?;
+                let chain = chain_nodes(&id, nodes, &p, &q, *n, &mut node_at, &mut node_order)?;
+                for (k, (a, bb)) in chain.iter().enumerate() {
+                    let (pa, pb) = (node_at[a].clone(), node_at[bb].clone());
+                    let eid = if *n == 1 {
+                        id.clone()
+                    } else {
+                        format!("{id}.{}", k + 1)
+                    };
+                    let element = match dim {
+                        Dimension::Planar => Element::planar_truss(
+                            [pa[0], pa[1]],
+                            [pb[0], pb[1]],
+                            *ea,
+                            *mass_per_length,
+                        ),
+                        Dimension::Spatial => Element::truss(
+                            [pa[0], pa[1], pa[2]],
+                            [pb[0], pb[1], pb[2]],
+                            *ea,
+                            *mass_per_length,
+                        ),
+                    }
+                    .map_err(wrap)?;
+                    expanded.push(Expanded {
+                        id: eid,
+                        group: id.clone(),
+                        element,
+                        attach: vec![Attach::Pos(a.clone()), Attach::Pos(bb.clone())],
+                    });
+                }
+            }
+            ElementSpec::Hinge {
+                nodes,
+                axis,
+                stiffness,
+                bending_stiffness,
+            } => {
+                node_ref(&nodes.0, &ctx, &node_at)?;
+                node_ref(&nodes.1, &ctx, &node_at)?;
+                let element = match dim {
+                    Dimension::Planar => Element::planar_hinge(*stiffness),
+                    Dimension::Spatial => {
+                        let a = axis.as_ref().ok_or_else(|| {
+                            ModelError::invalid(&ctx, "a spatial hinge needs an axis")
+                        })?;
+                        Element::hinge(vec3(&ctx, "axis", a)?, *stiffness, *bending_stiffness)
+                    }
+                }
+                .map_err(wrap)?;
+                expanded.push(Expanded {
+                    id: id.clone(),
+                    group: id.clone(),
+                    element,
+                    attach: vec![
+                        Attach::Orient(nodes.0.clone()),
+                        Attach::Orient(nodes.1.clone()),
+                    ],
+                });
+            }
+            ElementSpec::PointMass {
+                node,
+                mass,
+                inertia,
+            } => {
+                node_ref(node, &ctx, &node_at)?;
+                let (element, attach) = match dim {
+                    Dimension::Planar => (
+                        Element::planar_mass(*mass, *inertia).map_err(wrap)?,
+                        if inertia.is_some() {
+                            vec![Attach::Pos(node.clone()), Attach::Orient(node.clone())]
+                        } else {
+                            vec![Attach::Pos(node.clone())]
+                        },
+                    ),
+                    Dimension::Spatial => {
+                        if inertia.is_some() {
+                            return Err(ModelError::invalid(
+                                ctx,
+                                "use a RigidBody for rotary inertia in a spatial scene",
+                            ));
+                        }
+                        (
+                            Element::point_mass(*mass).map_err(wrap)?,
+                            vec![Attach::Pos(node.clone())],
+                        )
+                    }
+                };
+                expanded.push(Expanded {
+                    id: id.clone(),
+                    group: id.clone(),
+                    element,
+                    attach,
+                });
+            }
+            ElementSpec::RigidBody {
+                node,
+                mass,
+                com,
+                inertia,
+            } => {
+                if dim == Dimension::Planar {
+                    return Err(ModelError::invalid(
+                        ctx,
+                        "a RigidBody needs a spatial scene; use PointMass with inertia",
+                    ));
+                }
+                node_ref(node, &ctx, &node_at)?;
+                let com = match com {
+                    Some(c) => vec3(&ctx, "com", c)?,
+                    None => [0.0; 3],
+                };
+                if inertia.len() != 3 {
+                    return Err(ModelError::invalid(&ctx, "inertia must be a 3 × 3 matrix"));
+                }
+                let j = [
+                    vec3(&ctx, "inertia row", &inertia[0])?,
+                    vec3(&ctx, "inertia row", &inertia[1])?,
+                    vec3(&ctx, "inertia row", &inertia[2])?,
+                ];
+                let ident = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                let element = Element::rigid_body(*mass, com, j, ident).map_err(wrap)?;
+                expanded.push(Expanded {
+                    id: id.clone(),
+                    group: id.clone(),
+                    element,
+                    attach: vec![Attach::Pos(node.clone()), Attach::Orient(node.clone())],
+                });
+            }
+            ElementSpec::Superelement {
+                nodes,
+                file,
+                transform,
+                share,
+            } => {
+                if dim == Dimension::Planar {
+                    return Err(ModelError::invalid(
+                        ctx,
+                        "superelements need a spatial scene",
+                    ));
+                }
+                let p = node_ref(&nodes.0, &ctx, &node_at)?;
+                let q = node_ref(&nodes.1, &ctx, &node_at)?;
+                let path = match base_dir {
+                    Some(d) => d.join(file),
+                    None => Path::new(file).to_path_buf(),
+                };
+                let text = std::fs::read_to_string(&path).map_err(|e| ModelError::Io {
+                    path: path.display().to_string(),
+                    message: e.to_string(),
+                })?;
+                let data: LinearSuperelement =
+                    crate::parse_ron(&text, &path.display().to_string())?;
+                let l =
+                    ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt();
+                if (l - data.l0).abs() > 1e-9 * data.l0.max(1e-12) {
+                    return Err(ModelError::invalid(
+                        ctx,
+                        format!(
+                            "the nodes are {l} m apart but the superelement file has l0 = {} m",
+                            data.l0
+                        ),
+                    ));
+                }
+                let element = Element::superelement(&data, *transform).map_err(wrap)?;
+                let (kp, kq, kf) = data.mode_counts();
+                let gp = share.0.clone().unwrap_or_else(|| format!("{id}.p"));
+                let gq = share.1.clone().unwrap_or_else(|| format!("{id}.q"));
+                let gf = format!("{id}.f");
+                for (g, k) in [(&gp, kp), (&gq, kq), (&gf, kf)] {
+                    match mode_groups.iter().find(|(n, _)| n == g) {
+                        Some((_, n)) if *n != k => {
+                            return Err(ModelError::invalid(
+                                ctx,
+                                format!("mode group '{g}' has {n} modes elsewhere but {k} here"),
+                            ))
+                        }
+                        Some(_) => {}
+                        None => mode_groups.push((g.clone(), k)),
+                    }
+                }
+                expanded.push(Expanded {
+                    id: id.clone(),
+                    group: id.clone(),
+                    element,
+                    attach: vec![
+                        Attach::Pos(nodes.0.clone()),
+                        Attach::Orient(nodes.0.clone()),
+                        Attach::Pos(nodes.1.clone()),
+                        Attach::Orient(nodes.1.clone()),
+                        Attach::Group(gp),
+                        Attach::Group(gq),
+                        Attach::Group(gf),
+                    ],
+                });
+            }
+        }
+    }
+    if expanded.is_empty() {
+        return Err(ModelError::invalid("scene", "has no elements"));
+    }
+    // ---- coordinates
+    let mut needs_orient: HashMap<String, bool> = HashMap::new();
+    for e in &expanded {
+        for a in &e.attach {
+            match a {
+                Attach::Orient(n) => {
+                    needs_orient.insert(n.clone(), true);
+                }
+                Attach::Pos(n) => {
+                    needs_orient.entry(n.clone()).or_insert(false);
+                }
+                Attach::Group(_) => {}
+            }
+        }
+    }
+    let mut nodes = vec![];
+    let mut x0 = vec![];
+    let mut x_names = vec![];
+    for id in &node_order {
+        let at = node_at[id].clone();
+        let position: Vec<usize> = (0..nd).map(|k| x0.len() + k).collect();
+        for (k, c) in ["x", "y", "z"].iter().take(nd).enumerate() {
+            x0.push(at[k]);
+            x_names.push(format!("{id}.{c}"));
+        }
+        let orientation = if needs_orient.get(id).copied().unwrap_or(false) {
+            let start = x0.len();
+            match dim {
+                Dimension::Planar => {
+                    x0.push(0.0);
+                    x_names.push(format!("{id}.angle"));
+                    Some(vec![start])
+                }
+                Dimension::Spatial => {
+                    x0.extend(EulerParameters::identity().0);
+                    for k in 0..4 {
+                        x_names.push(format!("{id}.l{k}"));
+                    }
+                    Some((start..start + 4).collect())
+                }
+            }
+        } else {
+            None
+        };
+        nodes.push(NodeInfo {
+            id: id.clone(),
+            at,
+            position,
+            orientation,
+        });
+    }
+    let mut groups = vec![];
+    for (g, k) in &mode_groups {
+        let idx: Vec<usize> = (x0.len()..x0.len() + k).collect();
+        for i in 0..*k {
+            x0.push(0.0);
+            x_names.push(format!("{g}.eta{}", i + 1));
+        }
+        groups.push((g.clone(), idx));
+    }
+    let node_idx: HashMap<&str, usize> = nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.id.as_str(), i))
+        .collect();
+    // ---- place elements
+    let mut elements = vec![];
+    let mut eps_names = vec![];
+    for e in expanded {
+        let mut x_index = vec![];
+        for (slot, a) in e.element.slots().iter().zip(&e.attach) {
+            match a {
+                Attach::Pos(n) => x_index.extend(&nodes[node_idx[n.as_str()]].position),
+                Attach::Orient(n) => x_index.extend(
+                    nodes[node_idx[n.as_str()]]
+                        .orientation
+                        .as_ref()
+                        .expect("allocated"),
+                ),
+                Attach::Group(g) => {
+                    x_index.extend(&groups.iter().find(|(n, _)| n == g).expect("allocated").1)
+                }
+            }
+            debug_assert!(slot.len() <= x_index.len());
+        }
+        debug_assert_eq!(x_index.len(), e.element.n_x());
+        let eps_offset = eps_names.len();
+        for n in e.element.deformation_names() {
+            eps_names.push(format!("{}.{n}", e.id));
+        }
+        elements.push(MechElement {
+            id: e.id,
+            group: e.group,
+            element: e.element,
+            x_index,
+            eps_offset,
+        });
+    }
+    if dim == Dimension::Spatial {
+        for n in &nodes {
+            if let Some(o) = &n.orientation {
+                let element = Element::normalization();
+                let eps_offset = eps_names.len();
+                eps_names.push(format!("{}.normalization", n.id));
+                elements.push(MechElement {
+                    id: format!("{}.norm", n.id),
+                    group: n.id.clone(),
+                    element,
+                    x_index: o.clone(),
+                    eps_offset,
+                });
+            }
+        }
+    }
+    let n_x = x0.len();
+    let n_eps = eps_names.len();
+    let mut mech = Mechanism {
+        name: scene.name.clone(),
+        dimension: dim,
+        nodes,
+        mode_groups: groups,
+        x0,
+        x_names,
+        eps_names,
+        elements,
+        x_roles: vec![XRole::Dependent(0); n_x],
+        e_roles: vec![ERole::Dependent; n_eps],
+        dofs: vec![],
+        inputs: vec![],
+        dependent: vec![],
+        constraint_rows: vec![],
+        gravity,
+        loads: vec![],
+        controllers: vec![],
+        outputs: scene.outputs.clone(),
+        initial_xd: vec![0.0; n_x],
+    };
+    crate::roles::assign(scene, &mut mech)?;
+    crate::loads::assign(scene, &mut mech)?;
+    Ok(mech)
+}
+
+fn vec3(ctx: &str, what: &str, v: &[f64]) -> Result<[f64; 3], ModelError> {
+    if v.len() != 3 {
+        return Err(ModelError::invalid(
+            ctx,
+            format!("{what} must have 3 components, got {}", v.len()),
+        ));
+    }
+    finite_vec(&format!("{ctx} {what}"), v)?;
+    Ok([v[0], v[1], v[2]])
+}
+
+pub(crate) fn opt_vec3(
+    ctx: &str,
+    what: &str,
+    v: &Option<Vec<f64>>,
+) -> Result<[f64; 3], ModelError> {
+    match v {
+        Some(v) => vec3(ctx, what, v),
+        None => Ok([0.0; 3]),
+    }
+}
+
+fn chain_n(k: &ElementSpec) -> usize {
+    match k {
+        ElementSpec::Beam(b) => b.n,
+        ElementSpec::Truss { n, .. } => *n,
+        _ => 1,
+    }
+}
+
+fn default_up(axis: &[f64; 3]) -> [f64; 3] {
+    let a = Vector3::from(*axis).normalize();
+    if a.z.abs() < 0.9 {
+        [0.0, 0.0, 1.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    }
+}
+
+/// The node pairs of a chain of `n` elements from p to q, creating the
+/// intermediate nodes `ID.n1` … `ID.n(n−1)`.
+fn chain_nodes(
+    id: &str,
+    ends: &(String, String),
+    p: &[f64],
+    q: &[f64],
+    n: usize,
+    node_at: &mut BTreeMap<String, Vec<f64>>,
+    order: &mut Vec<String>,
+) -> Result<Vec<(String, String)>, ModelError> {
+    let mut names = vec![ends.0.clone()];
+    for k in 1..n {
+        let name = format!("{id}.n{k}");
+        let t = k as f64 / n as f64;
+        let at: Vec<f64> = p.iter().zip(q).map(|(a, b)| a + t * (b - a)).collect();
+        if node_at.insert(name.clone(), at).is_some() {
+            return Err(ModelError::DuplicateId {
+                kind: "node (made by the chain helper)",
+                id: name,
+            });
+        }
+        order.push(name.clone());
+        names.push(name);
+    }
+    names.push(ends.1.clone());
+    Ok(names
+        .windows(2)
+        .map(|w| (w[0].clone(), w[1].clone()))
+        .collect())
+}
+
+pub(crate) fn check_function(ctx: &str, f: &TimeFunction) -> Result<(), ModelError> {
+    f.validate().map_err(|m| ModelError::invalid(ctx, m))
+}

@@ -1,0 +1,859 @@
+//! Generalized-α method (Chung & Hulbert) for second-order systems in
+//! residual form, with Newton iterations and local error control.
+//!
+//! # Formulation
+//!
+//! The system is `g(t, q, q̇, q̈) = 0` ([`SecondOrderSystem`]). Following
+//! Chung & Hulbert (J. Appl. Mech. 60, 1993) in the form of Arnold & Brüls
+//! (Multibody Syst. Dyn. 18, 2007), the equations are satisfied at the end
+//! of each step and an auxiliary acceleration-like variable `a` carries the
+//! α-weighting:
+//!
+//! ```text
+//! g(t_{n+1}, q_{n+1}, q̇_{n+1}, q̈_{n+1}) = 0
+//! (1 − α_m)·a_{n+1} + α_m·a_n = (1 − α_f)·q̈_{n+1} + α_f·q̈_n
+//! q_{n+1} = q_n + h·q̇_n + h²·((1/2 − β)·a_n + β·a_{n+1})
+//! q̇_{n+1} = q̇_n + h·((1 − γ)·a_n + γ·a_{n+1})
+//! ```
+//!
+//! with, for the spectral radius at infinity `ρ∞ ∈ [0, 1]` (default 0.8),
+//! `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`, `α_f = ρ∞/(ρ∞ + 1)`, `γ = 1/2 + α_f − α_m`,
+//! `β = (γ + 1/2)²/4`: second order, unconditionally stable for linear
+//! problems, and high frequencies damped to `ρ∞` per step. `a_0 = q̈_0`.
+//!
+//! # Newton iteration
+//!
+//! The unknown is `q_{n+1}`; `q̇` and `q̈` follow with `∂q̇/∂q = γ'` and
+//! `∂q̈/∂q = β'`, `β' = (1 − α_m)/(β h² (1 − α_f))`, `γ' = γ/(β h)`. The
+//! iteration matrix is `S = β'·M + γ'·C + K` with `M = ∂g/∂q̈`,
+//! `C = ∂g/∂q̇`, `K = ∂g/∂q` from [`SecondOrderSystem::tangent`]. The
+//! predictor keeps the acceleration (`q̈_{n+1} = q̈_n`).
+//!
+//! Modified Newton: the tangent matrices are evaluated at the start of a
+//! step and kept across iterations and steps; `S` is refactored (dense LU
+//! with partial pivoting) when `h` changes or the tangent is re-evaluated.
+//! The tangent is re-evaluated after a step whose contraction rate
+//! `θ = ‖Δ_k‖/‖Δ_{k−1}‖` exceeded
+//! [`GeneralizedAlphaOptions::jacobian_refresh`], and after a convergence
+//! failure with an old tangent; a failure with a fresh tangent halves `h`.
+//! Convergence (as in Hairer & Wanner's RADAU5) is declared when
+//! `η·‖Δ_k‖ ≤ newton_tol` with `η = θ/(1 − θ)` (on the first iteration `η`
+//! is carried over from the previous step), the norm being the weighted RMS
+//! norm of the position increment with weights `atol_i + rtol·|q_i|`.
+//!
+//! # Error estimate and step-size control
+//!
+//! The local error of the position is estimated as in Zienkiewicz & Xie
+//! (Earthquake Eng. Struct. Dyn. 20, 1991) and Géradin's estimator, adapted
+//! to generalized-α: expanding the update formulas with
+//! `a_n ≈ q̈(t_n + (α_m − α_f)h)` gives the local error
+//! `(β − γ/2 + 1/12)·h³·q⃛`, estimated by
+//!
+//! ```text
+//! e = (β − γ/2 + 1/12)·h²·(q̈_{n+1} − q̈_n)
+//! ```
+//!
+//! (for `ρ∞ = 1` this is the trapezoidal rule's `h³ q⃛ /12`). The step is
+//! accepted if `‖e‖ ≤ 1` in the weighted RMS norm with weights
+//! `atol_i + rtol·max(|q_{n,i}|, |q_{n+1,i}|)`. The new step is
+//! `h·min(5, max(0.2, 0.9·‖e‖^(−1/3)))` (no increase right after a
+//! rejection); increases by less than 20% are not made, so that the
+//! factorization can be reused. As in `ode45`, a step within 10% of the
+//! remaining interval is stretched to end exactly at `t_end`.
+//!
+//! The initial acceleration solves `M q̈_0 = −g(t_0, q_0, q̇_0, 0)` (exact
+//! when `g` is affine in `q̈`), unless given.
+//!
+//! Dense output: cubic Hermite interpolation of `q` (from `q`, `q̇` at both
+//! ends of the step) and of `q̇` (from `q̇`, `q̈`); `q̈` is interpolated
+//! linearly. No extra evaluation.
+
+use faer::Mat;
+
+use crate::common::{
+    check_interval, check_optional_positive, check_positive, check_vector, first_non_finite,
+    spacing, wrap_rhs_error, Control, Output, Stats, Status, Tolerance,
+};
+use crate::error::OdeError;
+use crate::lu::DenseLu;
+use crate::system::SecondOrderSystem;
+
+/// Options of [`GeneralizedAlpha`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeneralizedAlphaOptions {
+    /// Spectral radius at infinity `ρ∞ ∈ [0, 1]`, default 0.8.
+    pub rho_inf: f64,
+    /// Relative tolerance on positions, default `1e-3`.
+    pub rtol: f64,
+    /// Absolute tolerance on positions, default `1e-6`.
+    pub atol: Tolerance,
+    /// Initial step size; `None` means `min(hmax, |t_end − t0|/100)`.
+    pub h0: Option<f64>,
+    /// Maximum step size; `None` means `|t_end − t0|`.
+    pub hmax: Option<f64>,
+    /// Maximum number of accepted steps, default 1 000 000.
+    pub max_steps: usize,
+    /// If set, integrate with this constant step (last step shortened to hit
+    /// `t_end`) and no error control; Newton still uses `rtol`/`atol`.
+    pub fixed_step: Option<f64>,
+    /// Maximum Newton iterations per attempt, default 8.
+    pub max_newton_iterations: usize,
+    /// Newton stopping tolerance in the weighted norm (1 = the local error
+    /// tolerance), default 0.01.
+    pub newton_tol: f64,
+    /// Contraction rate above which the tangent is re-evaluated for the next
+    /// step, default 0.25.
+    pub jacobian_refresh: f64,
+    /// Initial acceleration; `None` computes the consistent one.
+    pub initial_acceleration: Option<Vec<f64>>,
+}
+
+impl Default for GeneralizedAlphaOptions {
+    fn default() -> Self {
+        Self {
+            rho_inf: 0.8,
+            rtol: 1e-3,
+            atol: Tolerance::Scalar(1e-6),
+            h0: None,
+            hmax: None,
+            max_steps: 1_000_000,
+            fixed_step: None,
+            max_newton_iterations: 8,
+            newton_tol: 0.01,
+            jacobian_refresh: 0.25,
+            initial_acceleration: None,
+        }
+    }
+}
+
+impl GeneralizedAlphaOptions {
+    /// Sets `ρ∞`.
+    pub fn rho_inf(mut self, rho_inf: f64) -> Self {
+        self.rho_inf = rho_inf;
+        self
+    }
+    /// Sets the relative tolerance.
+    pub fn rtol(mut self, rtol: f64) -> Self {
+        self.rtol = rtol;
+        self
+    }
+    /// Sets the absolute tolerance (scalar or per component).
+    pub fn atol(mut self, atol: impl Into<Tolerance>) -> Self {
+        self.atol = atol.into();
+        self
+    }
+    /// Sets the initial step size.
+    pub fn h0(mut self, h0: f64) -> Self {
+        self.h0 = Some(h0);
+        self
+    }
+    /// Sets the maximum step size.
+    pub fn hmax(mut self, hmax: f64) -> Self {
+        self.hmax = Some(hmax);
+        self
+    }
+    /// Sets the maximum number of accepted steps.
+    pub fn max_steps(mut self, max_steps: usize) -> Self {
+        self.max_steps = max_steps;
+        self
+    }
+    /// Selects fixed-step mode with step `h`.
+    pub fn fixed_step(mut self, h: f64) -> Self {
+        self.fixed_step = Some(h);
+        self
+    }
+}
+
+/// The four parameters of the method.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlphaParameters {
+    /// `α_m`.
+    pub alpha_m: f64,
+    /// `α_f`.
+    pub alpha_f: f64,
+    /// `β`.
+    pub beta: f64,
+    /// `γ`.
+    pub gamma: f64,
+}
+
+impl AlphaParameters {
+    /// Chung–Hulbert parameters for the spectral radius at infinity `rho_inf`.
+    pub fn from_rho_inf(rho_inf: f64) -> Self {
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        let gamma = 0.5 + alpha_f - alpha_m;
+        let beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+        Self {
+            alpha_m,
+            alpha_f,
+            beta,
+            gamma,
+        }
+    }
+
+    /// Constant `C` of the local position error `C·h³·q⃛`.
+    pub fn error_constant(&self) -> f64 {
+        self.beta - 0.5 * self.gamma + 1.0 / 12.0
+    }
+}
+
+/// Solution of a second-order problem.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SecondOrderSolution {
+    t: Vec<f64>,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+    dim: usize,
+    /// Work statistics.
+    pub stats: Stats,
+    /// Whether `t_end` was reached or the observer stopped the integration.
+    pub status: Status,
+}
+
+impl SecondOrderSolution {
+    fn with_capacity(dim: usize, points: usize) -> Self {
+        Self {
+            t: Vec::with_capacity(points),
+            q: Vec::with_capacity(points * dim),
+            qd: Vec::with_capacity(points * dim),
+            qdd: Vec::with_capacity(points * dim),
+            dim,
+            stats: Stats::default(),
+            status: Status::Completed,
+        }
+    }
+    /// Number of coordinates.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+    /// Number of stored points.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+    /// Whether no point is stored.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+    /// The stored times.
+    pub fn t(&self) -> &[f64] {
+        &self.t
+    }
+    /// Positions at the `i`-th point (panics if out of range).
+    pub fn q(&self, i: usize) -> &[f64] {
+        &self.q[i * self.dim..(i + 1) * self.dim]
+    }
+    /// Velocities at the `i`-th point (panics if out of range).
+    pub fn qd(&self, i: usize) -> &[f64] {
+        &self.qd[i * self.dim..(i + 1) * self.dim]
+    }
+    /// Accelerations at the `i`-th point (panics if out of range).
+    pub fn qdd(&self, i: usize) -> &[f64] {
+        &self.qdd[i * self.dim..(i + 1) * self.dim]
+    }
+}
+
+/// Kinematic state at one time.
+struct State {
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+    /// Auxiliary acceleration `a`.
+    a: Vec<f64>,
+}
+
+impl State {
+    fn zeros(n: usize) -> Self {
+        Self {
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+            a: vec![0.0; n],
+        }
+    }
+}
+
+/// Output collection for second-order solutions.
+struct Sink<'o, F> {
+    output: &'o Output,
+    next_time: usize,
+    solution: SecondOrderSolution,
+    observer: F,
+    buf: State,
+}
+
+impl<F: FnMut(f64, &[f64], &[f64], &[f64]) -> Control> Sink<'_, F> {
+    fn emit(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> Control {
+        let s = &mut self.solution;
+        s.t.push(t);
+        s.q.extend_from_slice(q);
+        s.qd.extend_from_slice(qd);
+        s.qdd.extend_from_slice(qdd);
+        let c = (self.observer)(t, q, qd, qdd);
+        if c == Control::Stop {
+            s.status = Status::Stopped { t };
+        }
+        c
+    }
+
+    fn initial(&mut self, t0: f64, x: &State) -> Control {
+        match self.output {
+            Output::Steps => self.emit(t0, &x.q, &x.qd, &x.qdd),
+            Output::Times(times) => {
+                while self.next_time < times.len() && times[self.next_time] == t0 {
+                    self.next_time += 1;
+                    if self.emit(t0, &x.q, &x.qd, &x.qdd) == Control::Stop {
+                        return Control::Stop;
+                    }
+                }
+                Control::Continue
+            }
+            Output::Final => Control::Continue,
+        }
+    }
+
+    /// Emits the requested points of the step `(t, x0) → (t1, x1)`.
+    fn step(&mut self, t: f64, t1: f64, x0: &State, x1: &State, is_last: bool) -> Control {
+        match self.output {
+            Output::Steps => self.emit(t1, &x1.q, &x1.qd, &x1.qdd),
+            Output::Final => {
+                if is_last {
+                    self.emit(t1, &x1.q, &x1.qd, &x1.qdd)
+                } else {
+                    Control::Continue
+                }
+            }
+            Output::Times(times) => {
+                let dir = (t1 - t).signum();
+                while self.next_time < times.len() {
+                    let tau = times[self.next_time];
+                    if !is_last && dir * (tau - t1) > 0.0 {
+                        break;
+                    }
+                    self.next_time += 1;
+                    let c = if tau == t1 || is_last && dir * (tau - t1) >= 0.0 {
+                        self.emit(tau, &x1.q, &x1.qd, &x1.qdd)
+                    } else {
+                        let mut buf = std::mem::replace(&mut self.buf, State::zeros(0));
+                        hermite(t, t1, x0, x1, tau, &mut buf);
+                        let c = self.emit(tau, &buf.q, &buf.qd, &buf.qdd);
+                        self.buf = buf;
+                        c
+                    };
+                    if c == Control::Stop {
+                        return Control::Stop;
+                    }
+                }
+                Control::Continue
+            }
+        }
+    }
+}
+
+/// Hermite interpolation inside the step `[t, t1]`.
+fn hermite(t: f64, t1: f64, x0: &State, x1: &State, tau: f64, out: &mut State) {
+    let h = t1 - t;
+    let s = (tau - t) / h;
+    let s2 = s * s;
+    let s3 = s2 * s;
+    let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
+    let h10 = s3 - 2.0 * s2 + s;
+    let h01 = -2.0 * s3 + 3.0 * s2;
+    let h11 = s3 - s2;
+    for i in 0..x0.q.len() {
+        out.q[i] = h00 * x0.q[i] + h10 * h * x0.qd[i] + h01 * x1.q[i] + h11 * h * x1.qd[i];
+        out.qd[i] = h00 * x0.qd[i] + h10 * h * x0.qdd[i] + h01 * x1.qd[i] + h11 * h * x1.qdd[i];
+        out.qdd[i] = (1.0 - s) * x0.qdd[i] + s * x1.qdd[i];
+    }
+}
+
+/// Generalized-α integrator with step-size control; see the
+/// [module documentation](self).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GeneralizedAlpha {
+    /// The options.
+    pub options: GeneralizedAlphaOptions,
+}
+
+/// Tangent matrices and the factored iteration matrix.
+struct Linear {
+    mass: Mat<f64>,
+    damping: Mat<f64>,
+    stiffness: Mat<f64>,
+    lu: DenseLu,
+    /// Step size for which `lu` holds `S`, if it is valid.
+    h_lu: Option<f64>,
+    /// Whether the tangent was evaluated at the start of the current step.
+    fresh: bool,
+    /// The tangent should be re-evaluated before the next step.
+    stale: bool,
+}
+
+/// Result of one Newton solve.
+enum Newton {
+    Converged { theta_max: f64 },
+    Failed,
+    Singular,
+}
+
+impl GeneralizedAlpha {
+    /// Creates the integrator with the given options.
+    pub fn new(options: GeneralizedAlphaOptions) -> Self {
+        Self { options }
+    }
+
+    /// Integrates from `(t0, q0, q̇0)` to `t_end > t0` and stores the points
+    /// selected by `output`.
+    pub fn solve<S: SecondOrderSystem + ?Sized>(
+        &self,
+        sys: &mut S,
+        t0: f64,
+        q0: &[f64],
+        qd0: &[f64],
+        t_end: f64,
+        output: &Output,
+    ) -> Result<SecondOrderSolution, OdeError> {
+        self.solve_with(sys, t0, q0, qd0, t_end, output, |_, _, _, _| {
+            Control::Continue
+        })
+    }
+
+    /// Like [`GeneralizedAlpha::solve`], calling `observer(t, q, q̇, q̈)` at
+    /// every output point; the integration stops cleanly when it returns
+    /// [`Control::Stop`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_with<S, F>(
+        &self,
+        sys: &mut S,
+        t0: f64,
+        q0: &[f64],
+        qd0: &[f64],
+        t_end: f64,
+        output: &Output,
+        observer: F,
+    ) -> Result<SecondOrderSolution, OdeError>
+    where
+        S: SecondOrderSystem + ?Sized,
+        F: FnMut(f64, &[f64], &[f64], &[f64]) -> Control,
+    {
+        let o = &self.options;
+        let n = sys.dim();
+        check_interval(t0, t_end)?;
+        if t_end < t0 {
+            return Err(OdeError::InvalidInterval {
+                t0,
+                t_end,
+                reason: "generalized-α integrates forward in time only",
+            });
+        }
+        check_vector("q0", q0, n)?;
+        check_vector("qd0", qd0, n)?;
+        check_positive("rtol", o.rtol)?;
+        let atol = o.atol.expand("atol", n)?;
+        check_optional_positive("h0", o.h0)?;
+        check_optional_positive("hmax", o.hmax)?;
+        check_optional_positive("fixed_step", o.fixed_step)?;
+        check_positive("newton_tol", o.newton_tol)?;
+        if !(0.0..=1.0).contains(&o.rho_inf) {
+            return Err(OdeError::InvalidOption {
+                name: "rho_inf",
+                reason: format!("must be in [0, 1], got {}", o.rho_inf),
+            });
+        }
+        if !(o.jacobian_refresh > 0.0 && o.jacobian_refresh < 1.0) {
+            return Err(OdeError::InvalidOption {
+                name: "jacobian_refresh",
+                reason: format!("must be in (0, 1), got {}", o.jacobian_refresh),
+            });
+        }
+        if o.max_newton_iterations == 0 || o.max_steps == 0 {
+            return Err(OdeError::InvalidOption {
+                name: if o.max_steps == 0 {
+                    "max_steps"
+                } else {
+                    "max_newton_iterations"
+                },
+                reason: "must be at least 1".into(),
+            });
+        }
+        if let Some(a0) = &o.initial_acceleration {
+            check_vector("initial_acceleration", a0, n)?;
+        }
+        output.validate(t0, t_end)?;
+
+        let par = AlphaParameters::from_rho_inf(o.rho_inf);
+        let span = t_end - t0;
+        let hmax = o.hmax.unwrap_or(span).min(span);
+        let mut stats = Stats::default();
+        let mut lin = Linear {
+            mass: Mat::zeros(n, n),
+            damping: Mat::zeros(n, n),
+            stiffness: Mat::zeros(n, n),
+            lu: DenseLu::new(n),
+            h_lu: None,
+            fresh: false,
+            stale: true,
+        };
+        let mut x0 = State::zeros(n);
+        let mut x1 = State::zeros(n);
+        let mut r = vec![0.0; n];
+        let mut dq = vec![0.0; n];
+        let mut sink = Sink {
+            output,
+            next_time: 0,
+            solution: SecondOrderSolution::with_capacity(n, output.capacity_hint()),
+            observer,
+            buf: State::zeros(n),
+        };
+        let mut t = t0;
+        x0.q.copy_from_slice(q0);
+        x0.qd.copy_from_slice(qd0);
+
+        // Consistent initial acceleration.
+        match &o.initial_acceleration {
+            Some(a0) => x0.qdd.copy_from_slice(a0),
+            None => {
+                let zeros = &x1.qdd; // all zero at this point
+                eval_tangent(sys, t, &x0.q, &x0.qd, zeros, &mut lin, &mut stats)?;
+                lin.lu.matrix_mut().copy_from(&lin.mass);
+                stats.lu_decompositions += 1;
+                if !lin.lu.factor() {
+                    return Err(OdeError::SingularMatrix { what: "mass", t });
+                }
+                eval_residual(sys, t, &x0.q, &x0.qd, zeros, &mut r, &mut stats)?;
+                for (a, ri) in x0.qdd.iter_mut().zip(&r) {
+                    *a = -ri;
+                }
+                lin.lu.solve_in_place(&mut x0.qdd);
+                if let Some(index) = first_non_finite(&x0.qdd) {
+                    return Err(OdeError::NonFiniteState { t, index });
+                }
+                // The tangent is kept for the first step (evaluated at q̈ = 0).
+                lin.stale = false;
+            }
+        }
+        x0.a.copy_from_slice(&x0.qdd);
+
+        if sink.initial(t, &x0) == Control::Stop {
+            sink.solution.stats = stats;
+            return Ok(sink.solution);
+        }
+
+        let mut h = match (o.fixed_step, o.h0) {
+            (Some(hf), _) => hf,
+            (None, Some(h0)) => h0.min(hmax),
+            (None, None) => (0.01 * span).min(hmax),
+        };
+        let mut eta = 1.0f64;
+        let c_err = par.error_constant();
+        let pow = 1.0 / 3.0;
+
+        loop {
+            if stats.steps_accepted >= o.max_steps {
+                return Err(OdeError::MaxStepsExceeded {
+                    t,
+                    max_steps: o.max_steps,
+                });
+            }
+            let remaining = t_end - t;
+            let mut done = false;
+            let stretch = if o.fixed_step.is_some() {
+                1.0 - 1e-9
+            } else {
+                1.0 / 1.1
+            };
+            if h >= remaining * stretch {
+                h = remaining;
+                done = true;
+            }
+            if lin.stale {
+                eval_tangent(sys, t, &x0.q, &x0.qd, &x0.qdd, &mut lin, &mut stats)?;
+                lin.stale = false;
+                lin.fresh = true;
+                lin.h_lu = None;
+            }
+            let mut rejected = false;
+            let (t1, theta_max, err) = loop {
+                let h_min = 16.0 * spacing(t);
+                if h < h_min {
+                    return Err(OdeError::StepSizeTooSmall { t, h, h_min });
+                }
+                let t1 = if done { t_end } else { t + h };
+                if lin.h_lu != Some(h) {
+                    build_iteration_matrix(&mut lin, &par, h);
+                    stats.lu_decompositions += 1;
+                    if lin.lu.factor() {
+                        lin.h_lu = Some(h);
+                    } else {
+                        lin.h_lu = None;
+                    }
+                }
+                let result = if lin.h_lu.is_some() {
+                    newton(
+                        sys, o, &par, &atol, t1, h, &x0, &mut x1, &mut r, &mut dq, &mut lin,
+                        &mut eta, &mut stats,
+                    )?
+                } else {
+                    Newton::Singular
+                };
+                match result {
+                    Newton::Converged { theta_max } => {
+                        if o.fixed_step.is_some() {
+                            break (t1, theta_max, 0.0);
+                        }
+                        let mut sum = 0.0;
+                        for i in 0..n {
+                            let e = c_err * h * h * (x1.qdd[i] - x0.qdd[i]);
+                            let w = atol[i] + o.rtol * x0.q[i].abs().max(x1.q[i].abs());
+                            sum += (e / w) * (e / w);
+                        }
+                        let err = (sum / n.max(1) as f64).sqrt();
+                        if err <= 1.0 {
+                            break (t1, theta_max, err);
+                        }
+                        stats.steps_rejected += 1;
+                        rejected = true;
+                        h *= (0.9 * err.powf(-pow)).max(0.2);
+                        done = false;
+                        if theta_max > o.jacobian_refresh && !lin.fresh {
+                            eval_tangent(sys, t, &x0.q, &x0.qd, &x0.qdd, &mut lin, &mut stats)?;
+                            lin.fresh = true;
+                            lin.h_lu = None;
+                        }
+                    }
+                    Newton::Failed | Newton::Singular => {
+                        let singular = matches!(result, Newton::Singular);
+                        stats.newton_failures += usize::from(!singular);
+                        if !lin.fresh {
+                            eval_tangent(sys, t, &x0.q, &x0.qd, &x0.qdd, &mut lin, &mut stats)?;
+                            lin.fresh = true;
+                            lin.h_lu = None;
+                        } else if o.fixed_step.is_some() {
+                            return Err(if singular {
+                                OdeError::SingularMatrix {
+                                    what: "iteration",
+                                    t,
+                                }
+                            } else {
+                                OdeError::NewtonFailed { t, h }
+                            });
+                        } else {
+                            rejected = true;
+                            h *= 0.5;
+                            done = false;
+                        }
+                        eta = 1.0;
+                    }
+                }
+            };
+
+            let h_taken = t1 - t;
+            stats.record_accepted(h_taken);
+            let control = sink.step(t, t1, &x0, &x1, done);
+            std::mem::swap(&mut x0, &mut x1);
+            t = t1;
+            lin.fresh = false;
+            if theta_max > o.jacobian_refresh {
+                lin.stale = true;
+            }
+            if done || control == Control::Stop {
+                break;
+            }
+            if o.fixed_step.is_none() {
+                let mut factor = if err > 0.0 {
+                    (0.9 * err.powf(-pow)).clamp(0.2, 5.0)
+                } else {
+                    5.0
+                };
+                if rejected {
+                    factor = factor.min(1.0);
+                }
+                if (1.0..1.2).contains(&factor) {
+                    factor = 1.0;
+                }
+                h = (h_taken * factor).min(hmax);
+            }
+        }
+        sink.solution.stats = stats;
+        Ok(sink.solution)
+    }
+}
+
+fn eval_residual<S: SecondOrderSystem + ?Sized>(
+    sys: &mut S,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    r: &mut [f64],
+    stats: &mut Stats,
+) -> Result<(), OdeError> {
+    stats.rhs_evals += 1;
+    sys.residual(t, q, qd, qdd, r)
+        .map_err(|e| wrap_rhs_error(t, e))?;
+    match first_non_finite(r) {
+        Some(index) => Err(OdeError::NonFiniteRhs {
+            what: "residual",
+            t,
+            index,
+        }),
+        None => Ok(()),
+    }
+}
+
+fn eval_tangent<S: SecondOrderSystem + ?Sized>(
+    sys: &mut S,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    lin: &mut Linear,
+    stats: &mut Stats,
+) -> Result<(), OdeError> {
+    stats.jacobian_evals += 1;
+    sys.tangent(
+        t,
+        q,
+        qd,
+        qdd,
+        &mut lin.mass,
+        &mut lin.damping,
+        &mut lin.stiffness,
+    )
+    .map_err(|e| wrap_rhs_error(t, e))?;
+    let n = q.len();
+    for (m, mat) in [&lin.mass, &lin.damping, &lin.stiffness].iter().enumerate() {
+        if mat.nrows() != n || mat.ncols() != n {
+            return Err(OdeError::DimensionMismatch {
+                what: "tangent matrix",
+                expected: n,
+                found: mat.nrows(),
+            });
+        }
+        for j in 0..n {
+            for i in 0..n {
+                if !mat[(i, j)].is_finite() {
+                    return Err(OdeError::NonFiniteRhs {
+                        what: "tangent",
+                        t,
+                        index: m * n * n + j * n + i,
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `S = β'·M + γ'·C + K` into the LU workspace.
+fn build_iteration_matrix(lin: &mut Linear, par: &AlphaParameters, h: f64) {
+    let beta_p = (1.0 - par.alpha_m) / (par.beta * h * h * (1.0 - par.alpha_f));
+    let gamma_p = par.gamma / (par.beta * h);
+    let n = lin.mass.nrows();
+    let mut s = lin.lu.matrix_mut();
+    for j in 0..n {
+        for i in 0..n {
+            s[(i, j)] =
+                beta_p * lin.mass[(i, j)] + gamma_p * lin.damping[(i, j)] + lin.stiffness[(i, j)];
+        }
+    }
+}
+
+/// Predicts the state at `t1 = t + h` and solves the step equations by
+/// modified Newton iterations.
+#[allow(clippy::too_many_arguments)]
+fn newton<S: SecondOrderSystem + ?Sized>(
+    sys: &mut S,
+    o: &GeneralizedAlphaOptions,
+    par: &AlphaParameters,
+    atol: &[f64],
+    t1: f64,
+    h: f64,
+    x0: &State,
+    x1: &mut State,
+    r: &mut [f64],
+    dq: &mut [f64],
+    lin: &mut Linear,
+    eta: &mut f64,
+    stats: &mut Stats,
+) -> Result<Newton, OdeError> {
+    let n = x0.q.len();
+    let AlphaParameters {
+        alpha_m,
+        alpha_f,
+        beta,
+        gamma,
+    } = *par;
+    let beta_p = (1.0 - alpha_m) / (beta * h * h * (1.0 - alpha_f));
+    let gamma_p = gamma / (beta * h);
+    // Predictor: q̈_{n+1} = q̈_n.
+    for i in 0..n {
+        let qdd1 = x0.qdd[i];
+        let a1 =
+            ((1.0 - alpha_f) * qdd1 + alpha_f * x0.qdd[i] - alpha_m * x0.a[i]) / (1.0 - alpha_m);
+        x1.qdd[i] = qdd1;
+        x1.qd[i] = x0.qd[i] + h * ((1.0 - gamma) * x0.a[i] + gamma * a1);
+        x1.q[i] = x0.q[i] + h * x0.qd[i] + h * h * ((0.5 - beta) * x0.a[i] + beta * a1);
+    }
+    let mut eta_k = eta.max(f64::EPSILON).powf(0.8);
+    let mut prev_norm = 0.0;
+    let mut theta_max: f64 = 0.0;
+    for it in 0..o.max_newton_iterations {
+        eval_residual(sys, t1, &x1.q, &x1.qd, &x1.qdd, r, stats)?;
+        for (d, ri) in dq.iter_mut().zip(r.iter()) {
+            *d = -ri;
+        }
+        lin.lu.solve_in_place(dq);
+        stats.newton_iterations += 1;
+        if first_non_finite(dq).is_some() {
+            return Ok(Newton::Failed);
+        }
+        let mut sum = 0.0;
+        for i in 0..n {
+            x1.q[i] += dq[i];
+            x1.qd[i] += gamma_p * dq[i];
+            x1.qdd[i] += beta_p * dq[i];
+            let w = atol[i] + o.rtol * x1.q[i].abs();
+            sum += (dq[i] / w) * (dq[i] / w);
+        }
+        let norm = (sum / n.max(1) as f64).sqrt();
+        if it > 0 {
+            let theta = norm / prev_norm;
+            theta_max = theta_max.max(theta);
+            if theta >= 1.0 {
+                return Ok(Newton::Failed);
+            }
+            eta_k = theta / (1.0 - theta);
+        }
+        if eta_k * norm <= o.newton_tol || norm == 0.0 {
+            *eta = eta_k;
+            for i in 0..n {
+                x1.a[i] = ((1.0 - alpha_f) * x1.qdd[i] + alpha_f * x0.qdd[i] - alpha_m * x0.a[i])
+                    / (1.0 - alpha_m);
+            }
+            return Ok(Newton::Converged { theta_max });
+        }
+        prev_norm = norm;
+    }
+    Ok(Newton::Failed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parameters_from_rho_inf() {
+        // ρ∞ = 1: trapezoidal rule (average acceleration).
+        let p = AlphaParameters::from_rho_inf(1.0);
+        assert!((p.alpha_m - 0.5).abs() < 1e-15 && (p.alpha_f - 0.5).abs() < 1e-15);
+        assert!((p.gamma - 0.5).abs() < 1e-15 && (p.beta - 0.25).abs() < 1e-15);
+        assert!((p.error_constant() - 1.0 / 12.0).abs() < 1e-15);
+        // ρ∞ = 0.8 (Chung & Hulbert 1993, eq. 25 and 17-20).
+        let p = AlphaParameters::from_rho_inf(0.8);
+        assert!((p.alpha_m - 1.0 / 3.0).abs() < 1e-15);
+        assert!((p.alpha_f - 4.0 / 9.0).abs() < 1e-15);
+        assert!((p.gamma - (0.5 + 4.0 / 9.0 - 1.0 / 3.0)).abs() < 1e-15);
+    }
+}
