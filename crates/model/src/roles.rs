@@ -352,23 +352,30 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
     let project_x = |i: usize| -> Vec<f64> { (0..d).map(|k| null[(free_pos[&i], k)]).collect() };
     let mut chosen: Vec<Coordinate> = vec![];
     let nodal_candidates = |mech: &Mechanism| -> Vec<usize> {
-        // positions first, then orientation components with the largest
-        // reference value last (it becomes the dependent one), then modes
+        // planar angles first (a pinned link is best described by its angle),
+        // then positions, then Euler parameters with the largest reference
+        // value last (it becomes the dependent one), then mode amplitudes
+        let mut angles = vec![];
         let mut v = vec![];
         let mut orient = vec![];
         for n in &mech.nodes {
             v.extend(n.position.iter().copied());
-            if let Some(o) = &n.orientation {
-                let mut o = o.clone();
-                o.sort_by(|a, b| mech.x0[*a].abs().total_cmp(&mech.x0[*b].abs()));
-                orient.extend(o);
+            match &n.orientation {
+                Some(o) if o.len() == 1 => angles.push(o[0]),
+                Some(o) => {
+                    let mut o = o.clone();
+                    o.sort_by(|a, b| mech.x0[*a].abs().total_cmp(&mech.x0[*b].abs()));
+                    orient.extend(o);
+                }
+                None => {}
             }
         }
-        v.extend(orient);
+        angles.extend(v);
+        angles.extend(orient);
         for (_, g) in &mech.mode_groups {
-            v.extend(g.iter().copied());
+            angles.extend(g.iter().copied());
         }
-        v.into_iter().filter(|i| xr[*i] == R::Free).collect()
+        angles.into_iter().filter(|i| xr[*i] == R::Free).collect()
     };
     match &scene.dofs {
         DofChoice::Deformations | DofChoice::NodalCoordinates => {

@@ -1,0 +1,828 @@
+//! Geometric transfer functions of a flexible mechanism (thesis (5.7), (6.5)):
+//! x = F(q, u), ε = E(q, u) for the degrees of freedom q and the prescribed
+//! inputs u, solved by Newton's method, and their derivatives:
+//!
+//! * first order: F,ξ and E,ξ (ξ = (q, u)) from one factorization of the
+//!   Jacobian J of the constraint equations w.r.t. the dependent coordinates;
+//! * second order: the convective terms (F,ξξ ξ̇)ξ̇ and (E,ξξ ξ̇)ξ̇ by one more
+//!   solve with −D,xx\[ẋ, ẋ\] (thesis (5.8b), (6.6b));
+//! * the contraction F,qqᵀ w + E,qqᵀ σ of the geometric stiffness (E.5e) by one
+//!   adjoint solve with Jᵀ and element Hessians weighted by σ and the adjoint
+//!   multipliers. No third-order tensor is ever formed.
+//!
+//! The constraint equations are the rigid, degree-of-freedom and prescribed
+//! deformations (including the Euler-parameter normalizations): D_c(x) = (0, q_ε, u_ε).
+//!
+//! ```
+//! use flexmb_model::Scene;
+//! use flexmb_kinematics::Kinematics;
+//! use std::sync::Arc;
+//! let scene = Scene::from_ron_str(r#"(
+//!     dimension: Planar,
+//!     materials: { "al": (e: 7.0e10, rho: 2700.0) },
+//!     sections: { "bar": Rectangle(by: 0.01, bz: 0.02) },
+//!     nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [1.0, 0.0]) ],
+//!     elements: [ (id: "arm", type: Beam((nodes: ("A", "B"), material: "al", section: "bar"))) ],
+//!     fixed: [ Coord("A", Position) ],
+//!     rigid: [ Def("arm", "*") ],
+//! )"#).unwrap();
+//! let mut k = Kinematics::new(Arc::new(scene.build(None).unwrap()));
+//! // one DOF, the angle of node A: rotate the rigid arm to 90° in 15° steps
+//! for step in 1..=6 {
+//!     k.solve(&[step as f64 * 15f64.to_radians()], 0.0).unwrap();
+//!     k.first_order(); // also enables the first-order predictor of the next solve
+//! }
+//! let b = &k.mechanism().node("B").unwrap().position;
+//! assert!((k.x()[b[0]]).abs() < 1e-12 && (k.x()[b[1]] - 1.0).abs() < 1e-12);
+//! ```
+#![warn(missing_docs)]
+
+mod lu;
+
+pub use lu::DenseLu;
+
+use faer::Mat;
+use flexmb_model::{Coordinate, ERole, Mechanism, XRole};
+use std::sync::Arc;
+
+/// Newton settings of the position solve.
+#[derive(Clone, Copy, Debug)]
+pub struct NewtonOptions {
+    /// Converged when every constraint residual |D_c(x) − target| ≤ `tol`·L,
+    /// L the mean element length (residuals are lengths or dimensionless), or
+    /// when the Newton update is at rounding level (≤ 8 ε max|x|) with the
+    /// residual below 1000·`tol`·L.
+    pub tol: f64,
+    /// Iteration limit.
+    pub max_iterations: usize,
+}
+
+impl Default for NewtonOptions {
+    fn default() -> Self {
+        Self {
+            tol: 1e-12,
+            max_iterations: 30,
+        }
+    }
+}
+
+/// Kinematics failures, naming the coordinates involved.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum KinematicsError {
+    /// Newton did not converge.
+    #[error("the position solve did not converge in {iterations} iterations (residual {residual:.3e}); largest residuals: {equations:?}; largest last updates: {coordinates:?}. The configuration may be out of reach (a prescribed motion beyond the mechanism's range) or the step too large")]
+    NotConverged {
+        /// Iterations done.
+        iterations: usize,
+        /// Final max-norm residual.
+        residual: f64,
+        /// Equations with the largest residuals (name = value).
+        equations: Vec<String>,
+        /// Dependent coordinates with the largest last updates.
+        coordinates: Vec<String>,
+    },
+    /// The Jacobian of the constraints is singular at this configuration.
+    #[error("singular kinematics at this configuration (pivot ratio {pivot_ratio:.1e}): the dependent coordinates {coordinates:?} are not determined by the equations: a singular position of the mechanism (e.g. a straightened toggle), a lost constraint, or a starting guess far from the solution (take smaller steps)")]
+    Singular {
+        /// Smallest/largest pivot.
+        pivot_ratio: f64,
+        /// Coordinates in the null space.
+        coordinates: Vec<String>,
+    },
+    /// Non-finite input.
+    #[error("non-finite value in {what} at index {index}")]
+    NonFinite {
+        /// Which input.
+        what: &'static str,
+        /// Index.
+        index: usize,
+    },
+}
+
+struct ElemMap {
+    /// local deformation → constraint row
+    rows: Vec<Option<usize>>,
+    /// local coordinate → dependent column
+    cols: Vec<Option<usize>>,
+    nx: usize,
+    ne: usize,
+}
+
+/// Transfer functions and their derivatives for one mechanism; holds the
+/// current configuration and all work buffers (allocated once).
+pub struct Kinematics {
+    mech: Arc<Mechanism>,
+    opts: NewtonOptions,
+    maps: Vec<ElemMap>,
+    /// global row of each deformation (if it is an equation)
+    row_of: Vec<Option<usize>>,
+    /// ξ index of each coordinate: nodal coordinate → Some(k), deformation → Some(k)
+    xi_of_x: Vec<Option<usize>>,
+    xi_of_e: Vec<Option<usize>>,
+    length_scale: f64,
+    n_q: usize,
+    n_u: usize,
+    // state
+    t: f64,
+    xi: Vec<f64>,
+    xi_prev: Vec<f64>,
+    x: Vec<f64>,
+    eps: Vec<f64>,
+    prev_eps: Vec<f64>,
+    jac_local: Vec<Vec<f64>>,
+    jmat: Mat<f64>,
+    lu: DenseLu,
+    f: Mat<f64>,
+    e: Mat<f64>,
+    first_order_valid: bool,
+    have_solution: bool,
+    // velocity level
+    xid: Vec<f64>,
+    xd: Vec<f64>,
+    epsd: Vec<f64>,
+    // acceleration level
+    xdd0: Vec<f64>,
+    epsdd0: Vec<f64>,
+    // scratch
+    rhs: Mat<f64>,
+    work: Vec<f64>,
+    target: Vec<f64>,
+    iterations: usize,
+}
+
+impl Kinematics {
+    /// Prepares the kinematics of a mechanism, starting from its reference configuration.
+    pub fn new(mech: Arc<Mechanism>) -> Self {
+        faer::set_global_parallelism(faer::Par::Seq);
+        let n_x = mech.n_x();
+        let n_eps = mech.n_eps();
+        let n_c = mech.constraint_rows.len();
+        let mut row_of = vec![None; n_eps];
+        for (r, j) in mech.constraint_rows.iter().enumerate() {
+            row_of[*j] = Some(r);
+        }
+        let n_q = mech.n_dof();
+        let n_u = mech.inputs.len();
+        let mut xi_of_x = vec![None; n_x];
+        let mut xi_of_e = vec![None; n_eps];
+        for (k, c) in mech.dofs.iter().enumerate() {
+            match c {
+                Coordinate::Node(i) => xi_of_x[*i] = Some(k),
+                Coordinate::Def(j) => xi_of_e[*j] = Some(k),
+            }
+        }
+        for (k, inp) in mech.inputs.iter().enumerate() {
+            match inp.target {
+                Coordinate::Node(i) => xi_of_x[i] = Some(n_q + k),
+                Coordinate::Def(j) => xi_of_e[j] = Some(n_q + k),
+            }
+        }
+        let maps: Vec<ElemMap> = mech
+            .elements
+            .iter()
+            .map(|e| {
+                let ne = e.element.n_eps();
+                ElemMap {
+                    rows: (0..ne).map(|k| row_of[e.eps_offset + k]).collect(),
+                    cols: e
+                        .x_index
+                        .iter()
+                        .map(|i| match mech.x_roles[*i] {
+                            XRole::Dependent(k) => Some(k),
+                            _ => None,
+                        })
+                        .collect(),
+                    nx: e.element.n_x(),
+                    ne,
+                }
+            })
+            .collect();
+        let length_scale = characteristic_length(&mech);
+        let jac_local = mech
+            .elements
+            .iter()
+            .map(|e| vec![0.0; e.element.n_eps() * e.element.n_x()])
+            .collect();
+        let n_xi = n_q + n_u;
+        let mut s = Self {
+            opts: NewtonOptions::default(),
+            maps,
+            row_of,
+            xi_of_x,
+            xi_of_e,
+            length_scale,
+            n_q,
+            n_u,
+            t: 0.0,
+            xi: vec![0.0; n_xi],
+            xi_prev: vec![0.0; n_xi],
+            x: mech.x0.clone(),
+            eps: vec![0.0; n_eps],
+            prev_eps: vec![0.0; n_eps],
+            jac_local,
+            jmat: Mat::zeros(n_c, n_c),
+            lu: DenseLu::default(),
+            f: Mat::zeros(n_x, n_xi),
+            e: Mat::zeros(n_eps, n_xi),
+            first_order_valid: false,
+            have_solution: false,
+            xid: vec![0.0; n_xi],
+            xd: vec![0.0; n_x],
+            epsd: vec![0.0; n_eps],
+            xdd0: vec![0.0; n_x],
+            epsdd0: vec![0.0; n_eps],
+            rhs: Mat::zeros(n_c, n_xi),
+            work: vec![0.0; n_c.max(n_x)],
+            target: vec![0.0; n_c],
+            iterations: 0,
+            mech,
+        };
+        s.xi[..n_q].copy_from_slice(&s.mech.q0());
+        s
+    }
+
+    /// Sets the Newton options.
+    pub fn set_newton_options(&mut self, o: NewtonOptions) {
+        self.opts = o;
+    }
+    /// The mechanism.
+    pub fn mechanism(&self) -> &Arc<Mechanism> {
+        &self.mech
+    }
+    /// Number of degrees of freedom.
+    pub fn n_q(&self) -> usize {
+        self.n_q
+    }
+    /// Number of prescribed inputs.
+    pub fn n_u(&self) -> usize {
+        self.n_u
+    }
+    /// Nodal coordinates of the last solve.
+    pub fn x(&self) -> &[f64] {
+        &self.x
+    }
+    /// Deformations of the last solve.
+    pub fn eps(&self) -> &[f64] {
+        &self.eps
+    }
+    /// ξ = (q, u) of the last solve.
+    pub fn xi(&self) -> &[f64] {
+        &self.xi
+    }
+    /// Newton iterations of the last solve.
+    pub fn iterations(&self) -> usize {
+        self.iterations
+    }
+    /// F,ξ (n_x × (n_q + n_u)), valid after [`first_order`](Self::first_order).
+    pub fn f_xi(&self) -> &Mat<f64> {
+        &self.f
+    }
+    /// E,ξ (n_ε × (n_q + n_u)), valid after [`first_order`](Self::first_order).
+    pub fn e_xi(&self) -> &Mat<f64> {
+        &self.e
+    }
+    /// ẋ of the last [`velocities`](Self::velocities) call.
+    pub fn xd(&self) -> &[f64] {
+        &self.xd
+    }
+    /// ε̇ of the last [`velocities`](Self::velocities) call.
+    pub fn epsd(&self) -> &[f64] {
+        &self.epsd
+    }
+    /// ẍ for q̈ = 0: F,u ü + (F,ξξ ξ̇)ξ̇, after [`accelerations`](Self::accelerations).
+    pub fn xdd0(&self) -> &[f64] {
+        &self.xdd0
+    }
+    /// ε̈ for q̈ = 0, after [`accelerations`](Self::accelerations).
+    pub fn epsdd0(&self) -> &[f64] {
+        &self.epsdd0
+    }
+    /// The local deformation Jacobian D,x of element `k` (row-major), at the last solve.
+    pub fn element_jacobian(&self, k: usize) -> &[f64] {
+        &self.jac_local[k]
+    }
+
+    /// Overrides the current configuration (e.g. a previously converged state)
+    /// as the starting guess of the next solve.
+    pub fn set_guess(&mut self, x: &[f64]) {
+        self.x.copy_from_slice(x);
+        self.have_solution = false;
+    }
+
+    fn eval_elements(&mut self, with_jac: bool) {
+        let mech = &self.mech;
+        let mut xl = [0.0; 64];
+        for (k, e) in mech.elements.iter().enumerate() {
+            let m = &self.maps[k];
+            if m.ne == 0 {
+                continue;
+            }
+            for (c, gi) in e.x_index.iter().enumerate() {
+                xl[c] = self.x[*gi];
+            }
+            let o = e.eps_offset;
+            let prev = &self.prev_eps[o..o + m.ne];
+            let out = &mut self.eps[o..o + m.ne];
+            if with_jac {
+                e.element.deformations_and_jacobian(
+                    &xl[..m.nx],
+                    Some(prev),
+                    out,
+                    &mut self.jac_local[k],
+                );
+            } else {
+                e.element.deformations(&xl[..m.nx], Some(prev), out);
+            }
+        }
+    }
+
+    fn residual_norm(&self) -> f64 {
+        self.mech
+            .constraint_rows
+            .iter()
+            .enumerate()
+            .map(|(r, j)| (self.eps[*j] - self.target[r]).abs())
+            .fold(0.0f64, f64::max)
+    }
+
+    fn assemble_jacobian(&mut self) {
+        self.jmat.fill(0.0);
+        for (k, m) in self.maps.iter().enumerate() {
+            let jl = &self.jac_local[k];
+            for (a, r) in m.rows.iter().enumerate() {
+                let Some(r) = r else { continue };
+                for (c, col) in m.cols.iter().enumerate() {
+                    if let Some(col) = col {
+                        self.jmat[(*r, *col)] += jl[a * m.nx + c];
+                    }
+                }
+            }
+        }
+    }
+
+    fn singular_error(&self) -> KinematicsError {
+        // null space of J by SVD names the undetermined coordinates
+        let mut names = vec![];
+        if let Ok(svd) = self.jmat.svd() {
+            let s = svd.S().column_vector();
+            let n = s.nrows();
+            if n > 0 {
+                let v = svd.V();
+                let j = n - 1;
+                let mx = (0..n).map(|i| v[(i, j)].abs()).fold(0.0f64, f64::max);
+                for i in 0..n {
+                    if v[(i, j)].abs() > 0.2 * mx {
+                        names.push(self.mech.x_names[self.mech.dependent[i]].clone());
+                    }
+                }
+            }
+        }
+        KinematicsError::Singular {
+            pivot_ratio: self.lu.pivot_ratio,
+            coordinates: names,
+        }
+    }
+
+    /// Solves the configuration for degrees of freedom `q` at time `t`
+    /// (prescribed inputs from their time functions). Starts from the last
+    /// solution, extrapolated to first order with F,ξ when available.
+    pub fn solve(&mut self, q: &[f64], t: f64) -> Result<(), KinematicsError> {
+        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+            return Err(KinematicsError::NonFinite {
+                what: "q",
+                index: i,
+            });
+        }
+        let (n_q, n_u) = (self.n_q, self.n_u);
+        self.xi_prev.copy_from_slice(&self.xi);
+        self.xi[..n_q].copy_from_slice(q);
+        for k in 0..n_u {
+            self.xi[n_q + k] = self.mech.inputs[k].function.value(t);
+        }
+        self.t = t;
+        // first-order predictor x += F,ξ Δξ
+        if self.first_order_valid && self.have_solution {
+            for c in 0..n_q + n_u {
+                let d = self.xi[c] - self.xi_prev[c];
+                if d != 0.0 {
+                    for &i in &self.mech.dependent {
+                        self.x[i] += self.f[(i, c)] * d;
+                    }
+                }
+            }
+        }
+        self.first_order_valid = false;
+        // known coordinates
+        for (i, r) in self.mech.x_roles.iter().enumerate() {
+            match r {
+                XRole::Fixed => self.x[i] = self.mech.x0[i],
+                XRole::Dof(k) => self.x[i] = self.xi[*k],
+                XRole::Input(k) => self.x[i] = self.xi[n_q + k],
+                XRole::Dependent(_) => {}
+            }
+        }
+        // targets of the constraint rows
+        for (r, j) in self.mech.constraint_rows.iter().enumerate() {
+            self.target[r] = match self.mech.e_roles[*j] {
+                ERole::Dof(k) => self.xi[k],
+                ERole::Input(k) => self.xi[n_q + k],
+                _ => 0.0,
+            };
+        }
+        let tol = self.opts.tol * self.length_scale.max(1e-6);
+        let n_c = self.mech.constraint_rows.len();
+        let mut last_update: Vec<f64> = vec![0.0; n_c];
+        for it in 0..=self.opts.max_iterations {
+            self.eval_elements(true);
+            let mut res = 0.0f64;
+            for (r, j) in self.mech.constraint_rows.iter().enumerate() {
+                let v = self.eps[*j] - self.target[r];
+                self.work[r] = -v;
+                res = res.max(v.abs());
+            }
+            if !res.is_finite() {
+                break;
+            }
+            self.assemble_jacobian();
+            if !self.lu.factor(self.jmat.as_ref()) {
+                return Err(self.singular_error());
+            }
+            // converged: residual below tolerance, or Newton updates at rounding
+            // level while the residual is small (it cannot decrease further)
+            let x_scale = self
+                .mech
+                .dependent
+                .iter()
+                .fold(1.0f64, |m, &i| m.max(self.x[i].abs()));
+            let stalled = it > 0
+                && last_update.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+                    <= 8.0 * f64::EPSILON * x_scale
+                && res <= 1e3 * tol.max(1e-300);
+            if res <= tol || stalled {
+                self.iterations = it;
+                self.prev_eps.copy_from_slice(&self.eps);
+                self.have_solution = true;
+                return Ok(());
+            }
+            if it == self.opts.max_iterations {
+                break;
+            }
+            let mut dx = self.work[..n_c].to_vec();
+            self.lu.solve_vec(&mut dx);
+            // Newton step with backtracking: halve while the residual grows
+            let mut step = 1.0;
+            for _ in 0..6 {
+                for (k, &i) in self.mech.dependent.iter().enumerate() {
+                    self.x[i] += step * dx[k];
+                }
+                self.eval_elements(false);
+                let trial = self.residual_norm();
+                if trial.is_finite() && (trial < res || res < 1e3 * tol) {
+                    break;
+                }
+                for (k, &i) in self.mech.dependent.iter().enumerate() {
+                    self.x[i] -= step * dx[k];
+                }
+                step *= 0.5;
+                if step < 0.04 {
+                    // accept the smallest step: Newton may still recover
+                    for (k, &i) in self.mech.dependent.iter().enumerate() {
+                        self.x[i] += step * dx[k];
+                    }
+                    break;
+                }
+            }
+            last_update = dx.iter().map(|v| v * step).collect();
+        }
+        // failure report
+        let mut eq: Vec<(f64, String)> = self
+            .mech
+            .constraint_rows
+            .iter()
+            .enumerate()
+            .map(|(r, j)| {
+                (
+                    (self.eps[*j] - self.target[r]).abs(),
+                    self.mech.eps_names[*j].clone(),
+                )
+            })
+            .collect();
+        eq.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let mut co: Vec<(f64, String)> = self
+            .mech
+            .dependent
+            .iter()
+            .enumerate()
+            .map(|(k, i)| {
+                (
+                    last_update.get(k).copied().unwrap_or(0.0).abs(),
+                    self.mech.x_names[*i].clone(),
+                )
+            })
+            .collect();
+        co.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let residual = eq.first().map_or(f64::NAN, |e| e.0);
+        // restore a usable guess for the next attempt
+        self.x.copy_from_slice(&self.mech.x0);
+        self.have_solution = false;
+        Err(KinematicsError::NotConverged {
+            iterations: self.opts.max_iterations,
+            residual,
+            equations: eq
+                .iter()
+                .take(5)
+                .map(|(v, n)| format!("{n} = {v:.3e}"))
+                .collect(),
+            coordinates: co
+                .iter()
+                .take(5)
+                .map(|(v, n)| format!("{n} ({v:.3e})"))
+                .collect(),
+        })
+    }
+
+    /// F,ξ and E,ξ at the last solved configuration, from the factorization of
+    /// the last Newton iteration (thesis (5.8a), (6.6a)).
+    pub fn first_order(&mut self) {
+        let (n_q, n_u) = (self.n_q, self.n_u);
+        let n_xi = n_q + n_u;
+        self.rhs.fill(0.0);
+        // deformation coordinates in ξ: unit entries on their rows
+        for (j, k) in self.xi_of_e.iter().enumerate() {
+            if let (Some(k), Some(r)) = (k, self.row_of[j]) {
+                self.rhs[(r, *k)] = 1.0;
+            }
+        }
+        // nodal coordinates in ξ: −∂D_c/∂x_i
+        for (ei, e) in self.mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            let jl = &self.jac_local[ei];
+            for (c, gi) in e.x_index.iter().enumerate() {
+                let Some(k) = self.xi_of_x[*gi] else { continue };
+                for (a, r) in m.rows.iter().enumerate() {
+                    if let Some(r) = r {
+                        self.rhs[(*r, k)] -= jl[a * m.nx + c];
+                    }
+                }
+            }
+        }
+        self.lu.solve_in_place(self.rhs.as_mut());
+        self.f.fill(0.0);
+        for (k, &i) in self.mech.dependent.iter().enumerate() {
+            for c in 0..n_xi {
+                self.f[(i, c)] = self.rhs[(k, c)];
+            }
+        }
+        for (i, k) in self.xi_of_x.iter().enumerate() {
+            if let Some(k) = k {
+                self.f[(i, *k)] = 1.0;
+            }
+        }
+        // E,ξ = D,x F,ξ; exact for rigid / DOF / input rows
+        self.e.fill(0.0);
+        for (ei, e) in self.mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            let jl = &self.jac_local[ei];
+            for a in 0..m.ne {
+                let j = e.eps_offset + a;
+                if self.row_of[j].is_some() {
+                    if let Some(k) = self.xi_of_e[j] {
+                        self.e[(j, k)] = 1.0;
+                    }
+                    continue;
+                }
+                for (c, gi) in e.x_index.iter().enumerate() {
+                    let d = jl[a * m.nx + c];
+                    if d == 0.0 {
+                        continue;
+                    }
+                    for col in 0..n_xi {
+                        self.e[(j, col)] += d * self.f[(*gi, col)];
+                    }
+                }
+            }
+        }
+        self.first_order_valid = true;
+    }
+
+    /// ẋ = F,ξ ξ̇ and ε̇ = E,ξ ξ̇ with ξ̇ = (q̇, u̇(t)). Call after [`first_order`](Self::first_order).
+    pub fn velocities(&mut self, qd: &[f64]) {
+        let (n_q, n_u) = (self.n_q, self.n_u);
+        self.xid[..n_q].copy_from_slice(qd);
+        for k in 0..n_u {
+            self.xid[n_q + k] = self.mech.inputs[k].function.eval(self.t).1;
+        }
+        let n_xi = n_q + n_u;
+        for i in 0..self.xd.len() {
+            let mut s = 0.0;
+            for c in 0..n_xi {
+                s += self.f[(i, c)] * self.xid[c];
+            }
+            self.xd[i] = s;
+        }
+        for j in 0..self.epsd.len() {
+            let mut s = 0.0;
+            for c in 0..n_xi {
+                s += self.e[(j, c)] * self.xid[c];
+            }
+            self.epsd[j] = s;
+        }
+    }
+
+    /// The accelerations for q̈ = 0: ẍ0 = F,u ü + (F,ξξ ξ̇)ξ̇ and the matching
+    /// ε̈0, by one solve with −D,xx\[ẋ, ẋ\] (thesis (5.8b)). Call after
+    /// [`velocities`](Self::velocities). Then ẍ = F,q q̈ + ẍ0.
+    pub fn accelerations(&mut self) {
+        let n_u = self.n_u;
+        let n_c = self.mech.constraint_rows.len();
+        let mech = self.mech.clone();
+        // c = D,xx[ẋ, ẋ] per element
+        let mut xl = [0.0; 64];
+        let mut vl = [0.0; 64];
+        let mut c = [0.0; 64];
+        let mut rhs = vec![0.0; n_c];
+        for (ei, e) in mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            if m.ne == 0 {
+                continue;
+            }
+            let mut moving = false;
+            for (k, gi) in e.x_index.iter().enumerate() {
+                xl[k] = self.x[*gi];
+                vl[k] = self.xd[*gi];
+                moving |= vl[k] != 0.0;
+            }
+            let o = e.eps_offset;
+            if !moving {
+                self.epsdd0[o..o + m.ne].fill(0.0);
+                continue;
+            }
+            e.element.deformation_second_derivative(
+                &xl[..m.nx],
+                &vl[..m.nx],
+                &vl[..m.nx],
+                &mut c[..m.ne],
+            );
+            for a in 0..m.ne {
+                self.epsdd0[o + a] = c[a];
+                if let Some(r) = m.rows[a] {
+                    rhs[r] -= c[a];
+                }
+            }
+        }
+        // prescribed input accelerations ü
+        let mut udd = vec![0.0; n_u];
+        for k in 0..n_u {
+            udd[k] = mech.inputs[k].function.eval(self.t).2;
+            if let Coordinate::Def(j) = mech.inputs[k].target {
+                if let Some(r) = self.row_of[j] {
+                    rhs[r] += udd[k];
+                }
+            }
+        }
+        for (ei, e) in mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            let jl = &self.jac_local[ei];
+            for (cc, gi) in e.x_index.iter().enumerate() {
+                if let XRole::Input(k) = mech.x_roles[*gi] {
+                    for (a, r) in m.rows.iter().enumerate() {
+                        if let Some(r) = r {
+                            rhs[*r] -= jl[a * m.nx + cc] * udd[k];
+                        }
+                    }
+                }
+            }
+        }
+        self.lu.solve_vec(&mut rhs);
+        self.xdd0.fill(0.0);
+        for (k, &i) in mech.dependent.iter().enumerate() {
+            self.xdd0[i] = rhs[k];
+        }
+        for (i, r) in mech.x_roles.iter().enumerate() {
+            if let XRole::Input(k) = r {
+                self.xdd0[i] = udd[*k];
+            }
+        }
+        // ε̈0 = D,x ẍ0 + D,xx[ẋ, ẋ] (rows: exact targets)
+        for (ei, e) in mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            let jl = &self.jac_local[ei];
+            for a in 0..m.ne {
+                let j = e.eps_offset + a;
+                if self.row_of[j].is_some() {
+                    self.epsdd0[j] = match mech.e_roles[j] {
+                        ERole::Input(k) => udd[k],
+                        _ => 0.0,
+                    };
+                    continue;
+                }
+                let mut s = self.epsdd0[j];
+                for (cc, gi) in e.x_index.iter().enumerate() {
+                    s += jl[a * m.nx + cc] * self.xdd0[*gi];
+                }
+                self.epsdd0[j] = s;
+            }
+        }
+    }
+
+    /// The contraction G = F,qqᵀ w + E,qqᵀ σ (n_q × n_q, symmetric), the
+    /// geometric-stiffness term of (E.5e), by one adjoint solve:
+    /// G = F,qᵀ (Σ_dep σⱼ Dⱼ,xx − Σ_rows μᵣ Dᵣ,xx) F,q with Jᵀμ = (w + D,xᵀσ_dep)_dep.
+    /// Call after [`first_order`](Self::first_order).
+    pub fn second_order_contraction(&mut self, w: &[f64], sigma: &[f64]) -> Mat<f64> {
+        let mech = self.mech.clone();
+        let n_q = self.n_q;
+        let n_c = mech.constraint_rows.len();
+        // y = w + D,xᵀ σ_dep on the dependent coordinates
+        let mut y = vec![0.0; n_c];
+        for (k, &i) in mech.dependent.iter().enumerate() {
+            y[k] = w[i];
+        }
+        for (ei, e) in mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            let jl = &self.jac_local[ei];
+            for a in 0..m.ne {
+                let j = e.eps_offset + a;
+                if self.row_of[j].is_some() || sigma[j] == 0.0 {
+                    continue;
+                }
+                for (cc, col) in m.cols.iter().enumerate() {
+                    if let Some(col) = col {
+                        y[*col] += jl[a * m.nx + cc] * sigma[j];
+                    }
+                }
+            }
+        }
+        self.lu.solve_transpose_vec(&mut y);
+        let mu = y;
+        let mut g = Mat::<f64>::zeros(n_q, n_q);
+        let mut xl = [0.0; 64];
+        let mut wl = [0.0; 64];
+        let mut h = vec![0.0; 64 * 64];
+        for (ei, e) in mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            if m.ne == 0 {
+                continue;
+            }
+            let mut any = false;
+            for a in 0..m.ne {
+                let j = e.eps_offset + a;
+                wl[a] = match self.row_of[j] {
+                    Some(r) => -mu[r],
+                    None => sigma[j],
+                };
+                any |= wl[a] != 0.0;
+            }
+            if !any {
+                continue;
+            }
+            for (k, gi) in e.x_index.iter().enumerate() {
+                xl[k] = self.x[*gi];
+            }
+            let nx = m.nx;
+            e.element
+                .deformation_weighted_hessian(&xl[..nx], &wl[..m.ne], &mut h[..nx * nx]);
+            // G += F_eᵀ H F_e
+            let fe = Mat::from_fn(nx, n_q, |a, c| self.f[(e.x_index[a], c)]);
+            let he = Mat::from_fn(nx, nx, |a, b| h[a * nx + b]);
+            let hf = &he * &fe;
+            g += fe.transpose() * hf;
+        }
+        g
+    }
+}
+
+/// Mean distance between the first two position slots of the elements that
+/// have two nodes: the length unit of the Newton tolerance.
+fn characteristic_length(mech: &Mechanism) -> f64 {
+    use flexmb_element::Slot;
+    let mut sum = 0.0;
+    let mut n = 0usize;
+    for e in &mech.elements {
+        let slots = e.element.slots();
+        let mut starts = vec![];
+        let mut off = 0;
+        for s in slots {
+            if matches!(s, Slot::Position2 | Slot::Position3) {
+                starts.push((off, s.len()));
+            }
+            off += s.len();
+        }
+        if starts.len() >= 2 {
+            let ((a, k), (b, _)) = (starts[0], starts[1]);
+            let d: f64 = (0..k)
+                .map(|c| (mech.x0[e.x_index[b + c]] - mech.x0[e.x_index[a + c]]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            if d > 0.0 {
+                sum += d;
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        1.0
+    } else {
+        sum / n as f64
+    }
+}

@@ -1,0 +1,204 @@
+//! Transfer-function derivatives against differences of F along q + t q̇, and
+//! the geometric-stiffness contraction against differences of F,qᵀw + E,qᵀσ.
+
+use flexmb_kinematics::{Kinematics, KinematicsError, NewtonOptions};
+use flexmb_model::{DofChoice, Scene};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use std::path::Path;
+use std::sync::Arc;
+
+fn scene(name: &str) -> Scene {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes")
+        .join(name);
+    Scene::load(&p).unwrap()
+}
+
+fn kinematics(name: &str, dofs: DofChoice) -> Kinematics {
+    let mut s = scene(name);
+    s.dofs = dofs;
+    Kinematics::new(Arc::new(s.build(None).unwrap()))
+}
+
+/// A deflected configuration: q0 plus a random perturbation of a few percent
+/// of the flexure length in deformation terms.
+fn deflected(k: &Kinematics, rng: &mut StdRng, scale: f64) -> Vec<f64> {
+    let q0 = k.mechanism().q0();
+    q0.iter()
+        .map(|v| v + scale * rng.random_range(-1.0..1.0))
+        .collect()
+}
+
+fn x_at(k: &mut Kinematics, q: &[f64]) -> Vec<f64> {
+    k.solve(q, 0.0).unwrap();
+    k.x().to_vec()
+}
+
+fn check_first_and_second_order(name: &str, dofs: DofChoice, scale: f64) {
+    let mut rng = StdRng::seed_from_u64(3);
+    let mut k = kinematics(name, dofs);
+    // second differences amplify the solve tolerance by 1/h²: solve to rounding level
+    k.set_newton_options(NewtonOptions {
+        tol: 1e-17,
+        max_iterations: 30,
+    });
+    let nq = k.n_q();
+    for _ in 0..3 {
+        let q = deflected(&k, &mut rng, scale);
+        let qd: Vec<f64> = (0..nq).map(|_| rng.random_range(-0.01..0.01)).collect();
+        k.solve(&q, 0.0).unwrap();
+        k.first_order();
+        k.velocities(&qd);
+        k.accelerations();
+        let xd = k.xd().to_vec();
+        let conv = k.xdd0().to_vec();
+        let x0 = k.x().to_vec();
+        // central differences with step h and h/2, Richardson-extrapolated
+        // (eliminates the h² truncation term)
+        let along = |t: f64| -> Vec<f64> { q.iter().zip(&qd).map(|(a, b)| a + t * b).collect() };
+        let h = 2e-3;
+        let (xp, xm) = (x_at(&mut k, &along(h)), x_at(&mut k, &along(-h)));
+        let (xp2, xm2) = (
+            x_at(&mut k, &along(h / 2.0)),
+            x_at(&mut k, &along(-h / 2.0)),
+        );
+        let scale_v = xd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale_a = conv
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-3 * scale_v);
+        for i in 0..x0.len() {
+            let d1 = |p: f64, m: f64, h: f64| (p - m) / (2.0 * h);
+            let d2 = |p: f64, m: f64, h: f64| (p - 2.0 * x0[i] + m) / (h * h);
+            let fd1 = (4.0 * d1(xp2[i], xm2[i], h / 2.0) - d1(xp[i], xm[i], h)) / 3.0;
+            let fd2 = (4.0 * d2(xp2[i], xm2[i], h / 2.0) - d2(xp[i], xm[i], h)) / 3.0;
+            assert!(
+                (fd1 - xd[i]).abs() < 1e-7 * scale_v,
+                "{name}: F,q q̇ at {i}: {} vs {fd1}",
+                xd[i]
+            );
+            assert!(
+                (fd2 - conv[i]).abs() < 1e-7 * scale_a,
+                "{name}: (F,qq q̇)q̇ at {i}: {} vs {fd2}",
+                conv[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn spatial_guidance_deformation_dofs_first_and_second_order() {
+    check_first_and_second_order(
+        "straight_guidance_spatial.ron",
+        DofChoice::Deformations,
+        2e-3,
+    );
+}
+
+#[test]
+fn spatial_guidance_nodal_dofs_first_and_second_order() {
+    check_first_and_second_order(
+        "straight_guidance_spatial.ron",
+        DofChoice::NodalCoordinates,
+        2e-3,
+    );
+}
+
+#[test]
+fn planar_guidance_first_and_second_order() {
+    check_first_and_second_order(
+        "straight_guidance_planar.ron",
+        DofChoice::Deformations,
+        1e-3,
+    );
+}
+
+#[test]
+fn geometric_contraction_matches_differences() {
+    // G = ∂/∂q (F,qᵀ w + E,qᵀ σ) with w, σ frozen.
+    let mut rng = StdRng::seed_from_u64(4);
+    for dofs in [DofChoice::Deformations, DofChoice::NodalCoordinates] {
+        let mut k = kinematics("straight_guidance_spatial.ron", dofs);
+        let q = deflected(&k, &mut rng, 2e-3);
+        let (nx, ne, nq) = (k.x().len(), k.eps().len(), k.n_q());
+        let w: Vec<f64> = (0..nx).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let sigma: Vec<f64> = (0..ne).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let gen = |k: &mut Kinematics, q: &[f64]| -> Vec<f64> {
+            k.solve(q, 0.0).unwrap();
+            k.first_order();
+            let (f, e) = (k.f_xi(), k.e_xi());
+            (0..nq)
+                .map(|c| {
+                    (0..nx).map(|i| f[(i, c)] * w[i]).sum::<f64>()
+                        + (0..ne).map(|j| e[(j, c)] * sigma[j]).sum::<f64>()
+                })
+                .collect()
+        };
+        k.solve(&q, 0.0).unwrap();
+        k.first_order();
+        let g = k.second_order_contraction(&w, &sigma);
+        let h = 1e-6;
+        let mut maxg = 0.0f64;
+        let mut maxd = 0.0f64;
+        for c in 0..nq {
+            let mut qp = q.clone();
+            qp[c] += h;
+            let mut qm = q.clone();
+            qm[c] -= h;
+            let (a, b) = (gen(&mut k, &qp), gen(&mut k, &qm));
+            for r in 0..nq {
+                let fd = (a[r] - b[r]) / (2.0 * h);
+                maxg = maxg.max(fd.abs());
+                maxd = maxd.max((fd - g[(r, c)]).abs());
+            }
+        }
+        assert!(
+            maxd < 1e-6 * maxg,
+            "contraction error {maxd:e} relative to {maxg:e}"
+        );
+        for r in 0..nq {
+            for c in 0..nq {
+                assert!((g[(r, c)] - g[(c, r)]).abs() <= 1e-9 * maxg);
+            }
+        }
+    }
+}
+
+#[test]
+fn unreachable_configuration_reports_the_equations_that_fail() {
+    // a pendulum with its tip prescribed out of reach
+    let s = Scene::from_ron_str(
+        r#"(
+        dimension: Planar,
+        materials: { "al": (e: 7.0e10, rho: 2700.0) },
+        sections: { "bar": Rectangle(by: 0.01, bz: 0.02) },
+        nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [0.6, 0.8]) ],
+        elements: [ (id: "arm", type: Beam((nodes: ("A", "B"), material: "al", section: "bar"))) ],
+        fixed: [ Coord("A", Position) ],
+        rigid: [ Def("arm", "*") ],
+        prescribed: [ (what: Coord("B", X), function: Ramp(t0: 0.0, t1: 1.0, v0: 0.6, v1: 3.0)) ],
+    )"#,
+    )
+    .unwrap();
+    let mech = s.build(None).unwrap();
+    let mut k = Kinematics::new(Arc::new(mech));
+    k.solve(&[], 0.0).unwrap();
+    let e = k.solve(&[], 1.0).unwrap_err();
+    match &e {
+        KinematicsError::NotConverged { equations, .. }
+        | KinematicsError::Singular {
+            coordinates: equations,
+            ..
+        } => {
+            assert!(!equations.is_empty(), "{e}")
+        }
+        other => panic!("unexpected {other}"),
+    }
+    let msg = e.to_string();
+    assert!(
+        msg.contains("arm.") || msg.contains("B.") || msg.contains("A."),
+        "{msg}"
+    );
+    assert!(k.solve(&[f64::NAN], 0.0).is_err());
+}
