@@ -148,6 +148,8 @@ pub struct Kinematics {
     work: Vec<f64>,
     target: Vec<f64>,
     iterations: usize,
+    x_good: Vec<f64>,
+    xi_good: Vec<f64>,
 }
 
 impl Kinematics {
@@ -235,9 +237,12 @@ impl Kinematics {
             work: vec![0.0; n_c.max(n_x)],
             target: vec![0.0; n_c],
             iterations: 0,
+            x_good: mech.x0.clone(),
+            xi_good: vec![0.0; n_xi],
             mech,
         };
         s.xi[..n_q].copy_from_slice(&s.mech.q0());
+        s.xi_good.copy_from_slice(&s.xi);
         s
     }
 
@@ -387,6 +392,25 @@ impl Kinematics {
     /// (prescribed inputs from their time functions). Starts from the last
     /// solution, extrapolated to first order with F,ξ when available.
     pub fn solve(&mut self, q: &[f64], t: f64) -> Result<(), KinematicsError> {
+        let r = self.solve_inner(q, t);
+        match &r {
+            Ok(()) => {
+                self.x_good.copy_from_slice(&self.x);
+                self.xi_good.copy_from_slice(&self.xi);
+            }
+            Err(_) => {
+                // back to the last converged configuration: the next solve
+                // (e.g. a retried, smaller step) starts from a good guess
+                self.x.copy_from_slice(&self.x_good);
+                self.xi.copy_from_slice(&self.xi_good);
+                self.have_solution = true;
+                self.first_order_valid = false;
+            }
+        }
+        r
+    }
+
+    fn solve_inner(&mut self, q: &[f64], t: f64) -> Result<(), KinematicsError> {
         if let Some(i) = q.iter().position(|v| !v.is_finite()) {
             return Err(KinematicsError::NonFinite {
                 what: "q",
@@ -522,9 +546,6 @@ impl Kinematics {
             .collect();
         co.sort_by(|a, b| b.0.total_cmp(&a.0));
         let residual = eq.first().map_or(f64::NAN, |e| e.0);
-        // restore a usable guess for the next attempt
-        self.x.copy_from_slice(&self.mech.x0);
-        self.have_solution = false;
         Err(KinematicsError::NotConverged {
             iterations: self.opts.max_iterations,
             residual,

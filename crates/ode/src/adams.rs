@@ -507,7 +507,18 @@ impl AdamsState {
             }
             self.coefficients();
             // Block 2: predict, evaluate, estimate.
-            let est = self.predict_evaluate(sys, *x, y, stats)?;
+            let est = match self.predict_evaluate(sys, *x, y, stats) {
+                Ok(e) => e,
+                // the system could not be evaluated at the predicted point:
+                // treat as a failed step (restore, halve or reduce the order)
+                Err(e) if e.is_recoverable_rhs() && failures < 20 => Estimates {
+                    err: f64::INFINITY,
+                    erk: 2.0,
+                    erkm1: 2.0,
+                    erkm2: 2.0,
+                },
+                Err(e) => return Err(e),
+            };
             let k = self.k;
             let mut knew = k;
             if k >= 3 {

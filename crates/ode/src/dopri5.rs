@@ -323,7 +323,23 @@ impl Dopri5 {
             let err = loop {
                 let t_new = if done { t_end } else { t + h };
                 h = t_new - t;
-                attempt(sys, t, h, t_new, &mut w, &mut stats)?;
+                match attempt(sys, t, h, t_new, &mut w, &mut stats) {
+                    Ok(()) => {}
+                    Err(e) if e.is_recoverable_rhs() && o.fixed_step.is_none() => {
+                        // the system could not be evaluated at a stage: reject
+                        // the step and retry with a quarter of it
+                        stats.steps_rejected += 1;
+                        if absh <= hmin {
+                            return Err(e);
+                        }
+                        no_failure = false;
+                        absh = hmin.max(0.25 * absh);
+                        h = tdir * absh;
+                        done = false;
+                        continue;
+                    }
+                    Err(e) => return Err(e),
+                }
                 if o.fixed_step.is_some() {
                     break 0.0;
                 }

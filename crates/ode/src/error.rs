@@ -11,14 +11,31 @@ use std::fmt;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RhsError {
     message: String,
+    recoverable: bool,
 }
 
 impl RhsError {
-    /// Creates an error with the given message.
+    /// Creates an error with the given message; it aborts the integration.
     pub fn new(message: impl Into<String>) -> Self {
         Self {
             message: message.into(),
+            recoverable: false,
         }
+    }
+
+    /// Creates an error that a smaller step may avoid (e.g. a configuration
+    /// solve that failed at a stage far from the solution): the explicit
+    /// integrators reject the step and retry with a quarter of the step size.
+    pub fn recoverable(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+            recoverable: true,
+        }
+    }
+
+    /// Whether a smaller step may avoid the error.
+    pub fn is_recoverable(&self) -> bool {
+        self.recoverable
     }
 
     /// The message given at creation.
@@ -37,13 +54,20 @@ impl std::error::Error for RhsError {}
 
 impl From<String> for RhsError {
     fn from(message: String) -> Self {
-        Self { message }
+        Self::new(message)
     }
 }
 
 impl From<&str> for RhsError {
     fn from(message: &str) -> Self {
         Self::new(message)
+    }
+}
+
+impl OdeError {
+    /// Whether the error is a recoverable failure of the system's evaluation.
+    pub fn is_recoverable_rhs(&self) -> bool {
+        matches!(self, OdeError::Rhs { source, .. } if source.is_recoverable())
     }
 }
 

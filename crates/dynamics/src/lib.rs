@@ -1,0 +1,93 @@
+//! Equations of motion of flexible multibody mechanisms in independent
+//! coordinates (thesis Appendix D and E):
+//!
+//! * [`Dynamics::accelerations`]: Mq q̈ = F,qᵀ(f − Mx ẍ0 − h) − E,qᵀσ (D.10), with
+//!   Mq = F,qᵀ Mx F,q assembled element by element (no dense Mx) and
+//!   σ = Sε + Dε̇ + σ0 (E.2) including damping, initial stress and PD controllers;
+//! * [`Dynamics::residual`]: g(q, q̇, q̈, t) of (E.1);
+//! * [`Dynamics::static_equilibrium`]: Newton on Kq + Gq (E.6) with load
+//!   increments and held degrees of freedom;
+//! * [`Dynamics::energies`] and [`Dynamics::external_power`] for checks.
+//!
+//! ```
+//! use flexmb_model::Scene;
+//! use flexmb_dynamics::Dynamics;
+//! use std::sync::Arc;
+//! // a rigid pendulum (point mass on a massless rigid beam) released horizontally
+//! let scene = Scene::from_ron_str(r#"(
+//!     dimension: Planar,
+//!     gravity: Some([0.0, -9.81]),
+//!     materials: { "m": (e: 1.0e9, rho: 0.0) },
+//!     sections: { "s": Circle(d: 0.01) },
+//!     nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [1.0, 0.0]) ],
+//!     elements: [
+//!         (id: "rod", type: Beam((nodes: ("A", "B"), material: "m", section: "s", mass: false))),
+//!         (id: "bob", type: PointMass(node: "B", mass: 2.0)),
+//!     ],
+//!     fixed: [ Coord("A", Position) ],
+//!     rigid: [ Def("rod", "*") ],
+//! )"#).unwrap();
+//! let mut dy = Dynamics::new(Arc::new(scene.build(None).unwrap()));
+//! let mut qdd = [0.0];
+//! dy.accelerations(0.0, &[0.0], &[0.0], &mut qdd).unwrap();
+//! assert!((qdd[0] + 9.81).abs() < 1e-12); // φ̈ = −g/L
+//! ```
+#![warn(missing_docs)]
+
+mod eom;
+mod simulate;
+mod statics;
+
+pub use eom::{Dynamics, Energies};
+pub use flexmb_ode::{Control, Stats};
+pub use simulate::{FirstOrder, Integrator, SimulationOptions, Trajectory};
+pub use statics::{StaticOptions, StaticSolution};
+
+/// Failures of the dynamics layer, naming what failed.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum DynamicsError {
+    /// The kinematics failed at time t.
+    #[error("at t = {t}: {source}")]
+    Kinematics {
+        /// Time.
+        t: f64,
+        /// Cause.
+        source: flexmb_kinematics::KinematicsError,
+    },
+    /// The mass matrix Mq is not positive definite.
+    #[error("the mass matrix is not positive definite: degrees of freedom without inertia: {dofs:?} (give them mass, or make them rigid or prescribed)")]
+    SingularMass {
+        /// The massless DOFs.
+        dofs: Vec<String>,
+    },
+    /// A non-finite value.
+    #[error("non-finite {what} at index {index} (t = {t})")]
+    NonFinite {
+        /// Which quantity.
+        what: &'static str,
+        /// Index.
+        index: usize,
+        /// Time.
+        t: f64,
+    },
+    /// The static tangent is singular (buckling or a mechanism).
+    #[error("singular static tangent at load factor {load_factor}: the structure buckles or a motion is unrestrained")]
+    SingularTangent {
+        /// Load factor reached.
+        load_factor: f64,
+    },
+    /// Statics did not converge.
+    #[error("static equilibrium not found beyond load factor {load_factor}: {cause}")]
+    StaticNotConverged {
+        /// Last converged load factor.
+        load_factor: f64,
+        /// The last failure.
+        cause: String,
+    },
+    /// Invalid argument.
+    #[error("{0}")]
+    Invalid(String),
+    /// The integrator failed.
+    #[error("time integration failed: {0}")]
+    Integration(String),
+}

@@ -1,0 +1,264 @@
+//! Static equilibrium (only what statics needs: no inertia work): Newton on
+//! the tangent Kq + Gq of (E.6), with load increments and optionally some
+//! degrees of freedom held at given values (their reactions are reported).
+
+use crate::{Dynamics, DynamicsError};
+use faer::Mat;
+use flexmb_kinematics::DenseLu;
+use flexmb_model::{Coordinate, Load};
+use flexmb_rotation::EulerParameters;
+
+/// Settings of the static solver.
+#[derive(Clone, Debug)]
+pub struct StaticOptions {
+    /// Initial number of load increments (halved adaptively on failure).
+    pub load_steps: usize,
+    /// Newton iterations per increment.
+    pub max_iterations: usize,
+    /// Converged when ‖Δq‖∞ ≤ `tol`·(1 + ‖q‖∞) and the out-of-balance force is
+    /// ≤ 1e-6 of the applied generalized forces (or absolutely tiny).
+    pub tol: f64,
+    /// Degrees of freedom held at values: (index in q, value).
+    pub held: Vec<(usize, f64)>,
+    /// Smallest load increment before giving up.
+    pub min_increment: f64,
+}
+
+impl Default for StaticOptions {
+    fn default() -> Self {
+        Self {
+            load_steps: 1,
+            max_iterations: 25,
+            tol: 1e-11,
+            held: vec![],
+            min_increment: 1e-4,
+        }
+    }
+}
+
+/// An equilibrium.
+#[derive(Clone, Debug)]
+pub struct StaticSolution {
+    /// The degrees of freedom.
+    pub q: Vec<f64>,
+    /// Total Newton iterations.
+    pub iterations: usize,
+    /// Load increments used.
+    pub increments: usize,
+    /// Generalized reactions on the held degrees of freedom (the forces needed to hold them).
+    pub reactions: Vec<f64>,
+}
+
+impl Dynamics {
+    /// The static out-of-balance g_s = E,qᵀσ − F,qᵀf and the tangent
+    /// Kq + Gq − F,qᵀ f,x F,q (E.6) at (q, t), without inertia. Kq includes the
+    /// proportional gains of controllers.
+    pub fn static_tangent(
+        &mut self,
+        t: f64,
+        q: &[f64],
+    ) -> Result<(Vec<f64>, Mat<f64>), DynamicsError> {
+        self.kinematics_at(t, q, None)?;
+        self.forces(t, false);
+        self.w.copy_from_slice(&self.f);
+        self.generalized_force();
+        let g: Vec<f64> = self.rhs.iter().map(|v| -v).collect();
+        let k = self.structural_stiffness();
+        let neg_f: Vec<f64> = self.f.iter().map(|v| -v).collect();
+        let sigma = self.sigma.clone();
+        let mut tangent = self.kin.second_order_contraction(&neg_f, &sigma);
+        tangent += &k;
+        let l = self.load_stiffness(t);
+        tangent -= &l;
+        Ok((g, tangent))
+    }
+
+    /// Kq = E,qᵀ S E,q (E.6d) plus controller gains.
+    pub(crate) fn structural_stiffness(&self) -> Mat<f64> {
+        let mech = &self.mech;
+        let n_q = mech.n_dof();
+        let e = self.kin.e_xi();
+        let f = self.kin.f_xi();
+        let mut k = Mat::<f64>::zeros(n_q, n_q);
+        for el in &mech.elements {
+            let ne = el.element.n_eps();
+            if ne == 0 || el.element.stiffness().iter().all(|v| *v == 0.0) {
+                continue;
+            }
+            let o = el.eps_offset;
+            let ee = Mat::from_fn(ne, n_q, |a, c| {
+                if matches!(
+                    mech.e_roles[o + a],
+                    flexmb_model::ERole::Rigid | flexmb_model::ERole::Input(_)
+                ) {
+                    0.0
+                } else {
+                    e[(o + a, c)]
+                }
+            });
+            let s = Mat::from_fn(ne, ne, |a, b| el.element.stiffness()[(a, b)]);
+            let se = &s * &ee;
+            k += ee.transpose() * se;
+        }
+        for c in &mech.controllers {
+            let row: Vec<f64> = match c.on {
+                Coordinate::Node(i) => (0..n_q).map(|k| f[(i, k)]).collect(),
+                Coordinate::Def(j) => (0..n_q).map(|k| e[(j, k)]).collect(),
+            };
+            for a in 0..n_q {
+                for b in 0..n_q {
+                    k[(a, b)] += c.kp * row[a] * row[b];
+                }
+            }
+        }
+        k
+    }
+
+    /// F,qᵀ (∂f/∂x) F,q for position-dependent loads (consistent gravity on
+    /// rotating elements, moments on Euler parameters).
+    pub(crate) fn load_stiffness(&self, t: f64) -> Mat<f64> {
+        let mech = &self.mech;
+        let n_q = mech.n_dof();
+        let f = self.kin.f_xi();
+        let x = self.kin.x();
+        let mut l = Mat::<f64>::zeros(n_q, n_q);
+        let mut add = |idx: &[usize], d: &[f64], n: usize| {
+            let fe = Mat::from_fn(n, n_q, |a, c| f[(idx[a], c)]);
+            let de = Mat::from_fn(n, n, |a, b| d[a * n + b]);
+            let df = &de * &fe;
+            l += fe.transpose() * df;
+        };
+        if let Some(g0) = mech.gravity {
+            let g = g0.map(|v| v * self.load_factor);
+            let mut xl = [0.0; 64];
+            let mut d = vec![0.0; 64 * 64];
+            for e in &mech.elements {
+                if !e.element.has_inertia() {
+                    continue;
+                }
+                let n = e.x_index.len();
+                for (k, gi) in e.x_index.iter().enumerate() {
+                    xl[k] = x[*gi];
+                }
+                e.element
+                    .gravity_force_derivative(&xl[..n], &g, &mut d[..n * n]);
+                if d[..n * n].iter().any(|v| *v != 0.0) {
+                    add(&e.x_index, &d[..n * n], n);
+                }
+            }
+        }
+        for ld in &mech.loads {
+            if let Load::SpatialMoment { index, m, function } = ld {
+                // f_λ = 2 Λ(λ)ᵀ m s is linear in λ: ∂f/∂λ = 2 s ∂(Λᵀm)/∂λ
+                let s = self.load_factor * function.value(t);
+                let mut d = vec![0.0; 16];
+                for b in 0..4 {
+                    let mut e = [0.0; 4];
+                    e[b] = 1.0;
+                    let lt = EulerParameters(e).lambda().transpose();
+                    for a in 0..4 {
+                        d[a * 4 + b] =
+                            2.0 * s * (lt[(a, 0)] * m[0] + lt[(a, 1)] * m[1] + lt[(a, 2)] * m[2]);
+                    }
+                }
+                add(index, &d, 4);
+            }
+        }
+        l
+    }
+
+    /// Static equilibrium at time `t` (inputs at their values at t), starting
+    /// from `q0`, with load increments and held degrees of freedom.
+    pub fn static_equilibrium(
+        &mut self,
+        t: f64,
+        q0: &[f64],
+        opts: &StaticOptions,
+    ) -> Result<StaticSolution, DynamicsError> {
+        let n_q = self.mech.n_dof();
+        let mut q = q0.to_vec();
+        let mut held = vec![false; n_q];
+        for &(i, v) in &opts.held {
+            if i >= n_q {
+                return Err(DynamicsError::Invalid(format!(
+                    "held DOF index {i} ≥ {n_q}"
+                )));
+            }
+            held[i] = true;
+            q[i] = v;
+        }
+        let free: Vec<usize> = (0..n_q).filter(|i| !held[*i]).collect();
+        let mut lambda = 0.0;
+        let mut dl = 1.0 / opts.load_steps.max(1) as f64;
+        let mut iterations = 0;
+        let mut increments = 0;
+        let mut last_good = q.clone();
+        let mut last_err = None;
+        let mut lu = DenseLu::default();
+        while lambda < 1.0 - 1e-15 {
+            let target = (lambda + dl).min(1.0);
+            self.load_factor = target;
+            let mut converged = false;
+            for _it in 0..opts.max_iterations {
+                iterations += 1;
+                let (g, tan) = match self.static_tangent(t, &q) {
+                    Ok(v) => v,
+                    Err(e) => {
+                        last_err = Some(e);
+                        break;
+                    }
+                };
+                let tf = Mat::from_fn(free.len(), free.len(), |a, b| tan[(free[a], free[b])]);
+                if !lu.factor(tf.as_ref()) {
+                    last_err = Some(DynamicsError::SingularTangent {
+                        load_factor: target,
+                    });
+                    break;
+                }
+                let mut dq: Vec<f64> = free.iter().map(|i| -g[*i]).collect();
+                lu.solve_vec(&mut dq);
+                let qn = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let dn = dq.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for (k, i) in free.iter().enumerate() {
+                    q[*i] += dq[k];
+                }
+                if !dn.is_finite() {
+                    break;
+                }
+                if dn <= opts.tol * (1.0 + qn) {
+                    converged = true;
+                    break;
+                }
+            }
+            if converged {
+                lambda = target;
+                increments += 1;
+                last_good.copy_from_slice(&q);
+                dl = (dl * 2.0).min(1.0);
+            } else {
+                q.copy_from_slice(&last_good);
+                self.kin.set_guess(&self.mech.x0.clone());
+                let _ = self.kin.solve(&q, t);
+                dl *= 0.5;
+                if dl < opts.min_increment {
+                    self.load_factor = 1.0;
+                    return Err(DynamicsError::StaticNotConverged {
+                        load_factor: lambda,
+                        cause: last_err
+                            .map(|e| e.to_string())
+                            .unwrap_or_else(|| "Newton diverged".into()),
+                    });
+                }
+            }
+        }
+        self.load_factor = 1.0;
+        let (g, _) = self.static_tangent(t, &q)?;
+        let reactions = opts.held.iter().map(|(i, _)| g[*i]).collect();
+        Ok(StaticSolution {
+            q,
+            iterations,
+            increments,
+            reactions,
+        })
+    }
+}
