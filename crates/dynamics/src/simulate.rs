@@ -10,6 +10,9 @@ use flexmb_ode::{
 };
 use std::time::Instant;
 
+/// Mass, damping and stiffness tangents (M, C, K) of the residual.
+pub type TangentMatrices = (Mat<f64>, Mat<f64>, Mat<f64>);
+
 /// The integrators offered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Integrator {
@@ -172,7 +175,7 @@ impl Dynamics {
         q: &[f64],
         qd: &[f64],
         qdd: &[f64],
-    ) -> Result<(Mat<f64>, Mat<f64>, Mat<f64>), DynamicsError> {
+    ) -> Result<TangentMatrices, DynamicsError> {
         self.kinematics_at(t, q, Some(qd))?;
         self.forces(t, true);
         self.inertia(true);

@@ -1,0 +1,176 @@
+//! Ready-made parts for tests and examples, meshed with the built-in 20-node
+//! hexahedra, each with suggested build settings (boundary nodes and interface
+//! node sets selected geometrically).
+
+use crate::builder::{BuildSettings, PointMass};
+use crate::model::NodeSelection;
+use crate::solid::{Block, Mesh};
+use crate::Error;
+use flexmb_element::Material;
+
+/// A meshed part with suggested superelement settings.
+#[derive(Clone, Debug)]
+pub struct Part {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// Boundary nodes, interfaces (rigid) and rigid ties; no extra modes.
+    pub settings: BuildSettings,
+}
+
+fn plane_x(x: f64, scale: f64) -> NodeSelection {
+    NodeSelection::NearPlane {
+        point: [x, 0.0, 0.0],
+        normal: [1.0, 0.0, 0.0],
+        tolerance: 1e-9 * scale,
+    }
+}
+
+fn bar_like(
+    x0: f64,
+    len: f64,
+    by: f64,
+    bz: f64,
+    n: [usize; 3],
+    mat: Material,
+) -> Result<Part, Error> {
+    let mesh = Mesh::boxes(
+        &[Block {
+            min: [x0, -0.5 * by, -0.5 * bz],
+            max: [x0 + len, 0.5 * by, 0.5 * bz],
+            material: 0,
+        }],
+        &[mat],
+        [len / n[0] as f64, by / n[1] as f64, bz / n[2] as f64],
+    )?;
+    let s = len.max(by).max(bz);
+    let settings = BuildSettings::new(
+        [x0, 0.0, 0.0],
+        [x0 + len, 0.0, 0.0],
+        plane_x(x0, s),
+        plane_x(x0 + len, s),
+    );
+    Ok(Part { mesh, settings })
+}
+
+/// A prismatic bar along x from 0 to `l` with a `by` × `bz` rectangular section
+/// centred on the x axis, `n` elements along x, y, z; interfaces at its end faces.
+pub fn prismatic_bar(
+    l: f64,
+    by: f64,
+    bz: f64,
+    n: [usize; 3],
+    mat: Material,
+) -> Result<Part, Error> {
+    bar_like(0.0, l, by, bz, n, mat)
+}
+
+/// A segment of the short wide sheet flexure of thesis Fig. 3.9 (l = h =
+/// 0.04 m, t = 0.3 mm, steel): x from `x0` to `x0 + len`, height `h` along y,
+/// thickness `t` along z; `n` elements along x, y, z; interfaces at its ends.
+pub fn sheet_segment(
+    x0: f64,
+    len: f64,
+    h: f64,
+    t: f64,
+    n: [usize; 3],
+    mat: Material,
+) -> Result<Part, Error> {
+    bar_like(x0, len, h, t, n, mat)
+}
+
+/// A thin-walled box arm (rectangular tube) along x: outer width `w` (y),
+/// outer height `hz` (z), wall thickness `wall`; `n_len` elements along x, about
+/// `n_side` across each side, one element through the wall.
+pub fn box_arm(
+    l: f64,
+    w: f64,
+    hz: f64,
+    wall: f64,
+    n_len: usize,
+    n_side: usize,
+    mat: Material,
+) -> Result<Part, Error> {
+    if !(2.0 * wall < w.min(hz)) {
+        return Err(Error::Spec(format!(
+            "wall {wall} too thick for a {w} × {hz} box"
+        )));
+    }
+    let (y0, y1, z0, z1) = (-0.5 * w, 0.5 * w, -0.5 * hz, 0.5 * hz);
+    let blocks = [
+        Block {
+            min: [0.0, y0, z0],
+            max: [l, y1, z0 + wall],
+            material: 0,
+        },
+        Block {
+            min: [0.0, y0, z1 - wall],
+            max: [l, y1, z1],
+            material: 0,
+        },
+        Block {
+            min: [0.0, y0, z0 + wall],
+            max: [l, y0 + wall, z1 - wall],
+            material: 0,
+        },
+        Block {
+            min: [0.0, y1 - wall, z0 + wall],
+            max: [l, y1, z1 - wall],
+            material: 0,
+        },
+    ];
+    let hs = (w.max(hz) - 2.0 * wall) / n_side as f64;
+    let mesh = Mesh::boxes(&blocks, &[mat], [l / n_len as f64, hs, hs])?;
+    let s = l.max(w).max(hz);
+    let settings = BuildSettings::new(
+        [0.0, 0.0, 0.0],
+        [l, 0.0, 0.0],
+        plane_x(0.0, s),
+        plane_x(l, s),
+    );
+    Ok(Part { mesh, settings })
+}
+
+/// Half of the unbalanced rotating shaft of thesis Table 2.2 (rod d1 = 2 mm,
+/// eccentric cylinder d2 = 30 mm of length l = 75 mm with its axis offset by
+/// r = 11 mm): a rod along the x axis from x = −`rod_len` to 0 and the first
+/// half of the cylinder, x from 0 to l/2, centred at y = r. The rod length is
+/// not given in the thesis text; it is a parameter here. The rod's end face is
+/// tied to the cylinder's face by a massless rigid link (the meshes do not
+/// conform there). p is the rod's free end, q the shaft axis at mid-cylinder,
+/// interface q the whole cylinder section there.
+pub fn unbalanced_shaft_half(
+    rod_len: f64,
+    n_section: usize,
+    n_rod: usize,
+    n_cyl: usize,
+    mat: Material,
+) -> Result<Part, Error> {
+    let (d1, d2, l, r) = (2.0e-3, 3.0e-2, 7.5e-2, 1.1e-2);
+    let rod = Mesh::cylinder_x(-rod_len, [0.0, 0.0], rod_len, d1, 2, n_rod, mat)?;
+    let cyl = Mesh::cylinder_x(0.0, [r, 0.0], 0.5 * l, d2, n_section, n_cyl, mat)?;
+    let mesh = rod.merge(&cyl, 1e-12);
+    let s = rod_len + l;
+    let h = d2 / n_section as f64;
+    let tie = PointMass {
+        name: "rod–cylinder tie".into(),
+        mass: 0.0,
+        position: [0.0, 0.0, 0.0],
+        inertia: None,
+        nodes: NodeSelection::Intersection(vec![
+            plane_x(0.0, s),
+            NodeSelection::NearSegment {
+                a: [0.0, 0.0, 0.0],
+                b: [0.0, 0.0, 0.0],
+                radius: (0.5 * d1).max(0.75 * h) * 1.0001,
+            },
+        ]),
+    };
+    let mut settings = BuildSettings::new(
+        [-rod_len, 0.0, 0.0],
+        [0.5 * l, 0.0, 0.0],
+        plane_x(-rod_len, s),
+        plane_x(0.5 * l, s),
+    );
+    settings.point_masses.push(tie);
+    Ok(Part { mesh, settings })
+}

@@ -1,0 +1,201 @@
+//! The RON specification behind `flexmb build-superelement SPEC.ron`: where the
+//! FE model comes from, the build settings and where to write the result.
+//!
+//! ```ron
+//! (
+//!     name: "flexure",
+//!     model: CalculiX(job: "flexure"),
+//!     settings: (
+//!         p: (0.0, 0.0, 0.0),
+//!         q: (0.04, 0.0, 0.0),
+//!         interface_p: NearPlane(point: (0.0, 0.0, 0.0), normal: (1.0, 0.0, 0.0), tolerance: 1e-7),
+//!         interface_q: NearPlane(point: (0.04, 0.0, 0.0), normal: (1.0, 0.0, 0.0), tolerance: 1e-7),
+//!         warping_p: true,
+//!         warping_q: true,
+//!         normal_modes: 2,
+//!     ),
+//!     output: "flexure.se.ron",
+//! )
+//! ```
+
+use crate::builder::{build, BuildResult, BuildSettings};
+use crate::model::FeModel;
+use crate::readers::{
+    read_calculix, read_matrix_market_model, write_file, write_matrix_market_dense,
+};
+use crate::Error;
+use flexmb_element::LinearSuperelement;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Where the FE model comes from. Paths are relative to the spec's directory.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ModelSource {
+    /// CalculiX exports `JOB.sti`, `JOB.mas`, `JOB.dof` and the mesh `inp`
+    /// (default `JOB.inp`).
+    CalculiX {
+        /// The job path without extension.
+        job: String,
+        /// The mesh file, if not `JOB.inp`.
+        #[serde(default)]
+        inp: Option<String>,
+    },
+    /// Matrix Market K and M with a node file and an optional DOF file.
+    MatrixMarket {
+        /// Stiffness file.
+        k: String,
+        /// Mass file.
+        m: String,
+        /// Node file (`label x y z`).
+        nodes: String,
+        /// DOF file (`node.dir` per equation); default 3 DOFs per node.
+        #[serde(default)]
+        dofs: Option<String>,
+        /// Mesh volume [m³] for the units check, if known.
+        #[serde(default)]
+        volume: Option<f64>,
+    },
+}
+
+/// A build specification.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Spec {
+    /// A name for the part.
+    pub name: String,
+    /// The FE model.
+    pub model: ModelSource,
+    /// What to build.
+    pub settings: BuildSettings,
+    /// The RON file to write the superelement to (relative to the spec's directory).
+    pub output: String,
+    /// Also write M̄ as a Matrix Market array file (for large M̄).
+    #[serde(default)]
+    pub m_bar_matrix_market: Option<String>,
+}
+
+impl Spec {
+    /// Parses a RON spec.
+    pub fn from_ron(text: &str, file: &str) -> Result<Self, Error> {
+        ron::from_str(text).map_err(|e| Error::parse(file, e.span.start.line, e.code.to_string()))
+    }
+    /// Reads a RON spec file.
+    pub fn read(path: &Path) -> Result<Self, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Self::from_ron(&text, &path.display().to_string())
+    }
+}
+
+/// What [`build_from_spec`] produced.
+#[derive(Clone, Debug)]
+pub struct BuildOutput {
+    /// The build result.
+    pub result: BuildResult,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+}
+
+/// 64-bit FNV-1a hash of a byte string (provenance of source files).
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+fn source_entry(path: &Path) -> Result<String, Error> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    Ok(format!(
+        "{} ({} bytes, fnv1a64 {:016x})",
+        path.file_name()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default(),
+        bytes.len(),
+        fnv1a64(&bytes)
+    ))
+}
+
+/// Loads the model a spec names.
+pub fn load_model(spec: &Spec, base_dir: &Path) -> Result<(FeModel, Vec<PathBuf>), Error> {
+    Ok(match &spec.model {
+        ModelSource::CalculiX { job, inp } => {
+            let job = base_dir.join(job);
+            let inp = inp.as_ref().map(|p| base_dir.join(p));
+            let (mut model, _) = read_calculix(&job, inp.as_deref())?;
+            model.name = spec.name.clone();
+            let inp_path = inp.unwrap_or_else(|| job.with_extension("inp"));
+            let files = ["sti", "mas", "dof"]
+                .iter()
+                .map(|e| job.with_extension(e))
+                .chain([inp_path])
+                .collect();
+            (model, files)
+        }
+        ModelSource::MatrixMarket {
+            k,
+            m,
+            nodes,
+            dofs,
+            volume,
+        } => {
+            let (k, m, nodes) = (base_dir.join(k), base_dir.join(m), base_dir.join(nodes));
+            let dofs = dofs.as_ref().map(|d| base_dir.join(d));
+            let mut model = read_matrix_market_model(&spec.name, &k, &m, &nodes, dofs.as_deref())?;
+            model.volume = *volume;
+            let mut files = vec![k, m, nodes];
+            files.extend(dofs);
+            (model, files)
+        }
+    })
+}
+
+/// Writes superelement data as RON.
+pub fn write_ron(path: &Path, data: &LinearSuperelement) -> Result<(), Error> {
+    let s = ron::ser::to_string_pretty(data, ron::ser::PrettyConfig::default())
+        .map_err(|e| Error::Spec(format!("cannot serialize the superelement: {e}")))?;
+    write_file(path, &s)
+}
+
+/// Reads superelement data from RON.
+pub fn read_ron(path: &Path) -> Result<LinearSuperelement, Error> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    ron::from_str(&text).map_err(|e| {
+        Error::parse(
+            &path.display().to_string(),
+            e.span.start.line,
+            e.code.to_string(),
+        )
+    })
+}
+
+/// Loads the model, builds the superelement, records the provenance (source
+/// files with their FNV-1a hashes, the settings) and writes the RON output (and
+/// M̄ as Matrix Market if asked). Paths are relative to `base_dir`.
+pub fn build_from_spec(spec: &Spec, base_dir: &Path) -> Result<BuildOutput, Error> {
+    let (model, files) = load_model(spec, base_dir)?;
+    let mut result = build(&model, &spec.settings)?;
+    let mut sources = Vec::new();
+    for f in &files {
+        sources.push(source_entry(f)?);
+    }
+    sources.append(&mut result.data.provenance.sources);
+    result.data.provenance.sources = sources;
+    let settings_ron = ron::ser::to_string(&spec.settings)
+        .map_err(|e| Error::Spec(format!("cannot serialize the settings: {e}")))?;
+    result
+        .data
+        .provenance
+        .settings
+        .push(format!("spec settings: {settings_ron}"));
+    let mut written = Vec::new();
+    let out = base_dir.join(&spec.output);
+    write_ron(&out, &result.data)?;
+    written.push(out);
+    if let Some(mm) = &spec.m_bar_matrix_market {
+        let p = base_dir.join(mm);
+        write_matrix_market_dense(&p, &result.data.m_bar_matrix())?;
+        written.push(p);
+    }
+    Ok(BuildOutput { result, written })
+}

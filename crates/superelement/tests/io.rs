@@ -1,0 +1,353 @@
+//! Readers, the RON spec path and the catalogue of bad inputs (each gives an
+//! error naming the culprit, never a panic).
+
+use faer::sparse::{SparseColMat, Triplet};
+use flexmb_element::{Material, Side};
+use flexmb_superelement::readers::{
+    parse_calculix, parse_calculix_dof, parse_matrix_market, read_matrix_market_model,
+    write_matrix_market, write_nodes,
+};
+use flexmb_superelement::solid::{Block, Mesh};
+use flexmb_superelement::spec::read_ron;
+use flexmb_superelement::{
+    build, build_from_spec, parts, BuildSettings, DofMap, Error, FeModel, InterfaceMode,
+    InterfacePattern, ModelSource, NodeSelection, PointMass, Spec,
+};
+
+fn steel() -> Material {
+    Material {
+        e: 2.1e11,
+        g: 8.0e10,
+        rho: 7800.0,
+    }
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("flexmb-se-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn small_bar() -> (FeModel, BuildSettings) {
+    let part = parts::prismatic_bar(0.05, 0.01, 0.006, [4, 2, 1], steel()).unwrap();
+    (part.mesh.assemble("small").unwrap(), part.settings)
+}
+
+/// K, M and nodes written as Matrix Market + node file and read back give the
+/// same matrices (17 significant digits) and the same superelement; a spec
+/// pointing at them builds, writes RON with provenance, and reads back.
+#[test]
+fn matrix_market_round_trip_and_spec() {
+    let (model, settings) = small_bar();
+    let dir = tmp("mm");
+    write_matrix_market(&dir.join("k.mtx"), model.k()).unwrap();
+    write_matrix_market(&dir.join("m.mtx"), model.m()).unwrap();
+    write_nodes(&dir.join("nodes.txt"), model.node_ids(), model.coords()).unwrap();
+    let back = read_matrix_market_model(
+        "small",
+        &dir.join("k.mtx"),
+        &dir.join("m.mtx"),
+        &dir.join("nodes.txt"),
+        None,
+    )
+    .unwrap();
+    assert_eq!(back.n_eq(), model.n_eq());
+    let (a, b) = (model.k().to_dense(), back.k().to_dense());
+    assert!((&a - &b).norm_l2() <= 1e-15 * a.norm_l2());
+    let se1 = build(&model, &settings).unwrap();
+    let se2 = build(&back, &settings).unwrap();
+    for i in 0..6 {
+        for j in 0..6 {
+            let (x, y) = (se1.data.s_bar[i][j], se2.data.s_bar[i][j]);
+            assert!((x - y).abs() <= 1e-10 * se1.data.s_bar[i][i].abs());
+        }
+    }
+    let spec = Spec {
+        name: "small".into(),
+        model: ModelSource::MatrixMarket {
+            k: "k.mtx".into(),
+            m: "m.mtx".into(),
+            nodes: "nodes.txt".into(),
+            dofs: None,
+            volume: Some(0.05 * 0.01 * 0.006),
+        },
+        settings: settings.clone(),
+        output: "small.se.ron".into(),
+        m_bar_matrix_market: Some("m_bar.mtx".into()),
+    };
+    // the spec itself survives RON
+    let text = ron::ser::to_string_pretty(&spec, Default::default()).unwrap();
+    assert_eq!(Spec::from_ron(&text, "spec").unwrap(), spec);
+    let out = build_from_spec(&spec, &dir).unwrap();
+    assert_eq!(out.written.len(), 2);
+    let data = read_ron(&dir.join("small.se.ron")).unwrap();
+    assert_eq!(data, out.result.data);
+    assert!(data
+        .provenance
+        .sources
+        .iter()
+        .any(|s| s.starts_with("k.mtx") && s.contains("fnv1a64")));
+    data.validate().unwrap();
+}
+
+/// A general (full) Matrix Market file with both triangles is accepted; an
+/// unsymmetric one is rejected naming the entry.
+#[test]
+fn matrix_market_general_and_unsymmetric() {
+    let full = "%%MatrixMarket matrix coordinate real general\n3 3 5\n1 1 2.0\n1 2 -1.0\n2 1 -1.0\n2 2 2.0\n3 3 1.0\n";
+    let a = parse_matrix_market(full, "full.mtx").unwrap();
+    assert_eq!(a.compute_nnz(), 5);
+    let ids = vec![1];
+    let k = a.as_ref();
+    let model = FeModel::new("one", ids.clone(), vec![[0.0; 3]], DofMap::full(1), k, k).unwrap();
+    assert_eq!(model.k().compute_nnz(), 4);
+    let bad = "%%MatrixMarket matrix coordinate real general\n3 3 5\n1 1 2.0\n1 2 -1.0\n2 1 -1.5\n2 2 2.0\n3 3 1.0\n";
+    let a = parse_matrix_market(bad, "bad.mtx").unwrap();
+    let e = FeModel::new(
+        "one",
+        ids,
+        vec![[0.0; 3]],
+        DofMap::full(1),
+        a.as_ref(),
+        a.as_ref(),
+    )
+    .unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(e, Error::NotSymmetric(_))
+            && msg.contains("node 1 ux")
+            && msg.contains("node 1 uy"),
+        "{msg}"
+    );
+    let e = parse_matrix_market("%%MatrixMarket matrix array real general\n2 2\n", "arr.mtx")
+        .unwrap_err();
+    assert!(e.to_string().contains("arr.mtx:1") && e.to_string().contains("coordinate"));
+}
+
+/// A hand-written CalculiX set: nodes 1, 2, 3, 10 (a tetrahedron), with node
+/// 10's uz removed by a boundary condition (absent from .dof/.sti/.mas), "10.1"
+/// and "1.1" distinct, exact zeros in .sti, upper triangle column by column.
+#[test]
+fn calculix_hand_written_set() {
+    let inp = "** written by hand\n*NODE, NSET=Nall\n1, 0.0, 0.0, 0.0\n2, 1.0, 0.0, 0.0\n3, 0.0, 1.0, 0.0\n10, \
+               0.0, 0.0, 1.0\n*ELEMENT, TYPE=C3D4, ELSET=E\n1, 1, 2, 3, 10\n*NSET, NSET=TOP\n10\n";
+    // equations: 1.1 1.2 1.3 2.1 2.2 2.3 3.1 3.2 3.3 10.1 10.2 (10.3 absent)
+    let dof = "1.1\n1.2\n1.3\n2.1\n2.2\n2.3\n3.1\n3.2\n3.3\n10.1\n10.2\n";
+    let mut sti = String::new();
+    let mut mas = String::new();
+    for j in 1..=11 {
+        for i in 1..=j {
+            let v = if i == j {
+                4.0 + j as f64
+            } else if j - i == 1 {
+                -1.0
+            } else {
+                0.0
+            };
+            sti.push_str(&format!("{i} {j} {v:.6e}\n"));
+            if i == j {
+                mas.push_str(&format!("{i} {j} 1.0e-3\n"));
+            }
+        }
+    }
+    let (model, mesh) = parse_calculix(&sti, &mas, dof, inp, "hand").unwrap();
+    assert_eq!(model.n_eq(), 11);
+    let n10 = model.node_index(10).unwrap();
+    let n1 = model.node_index(1).unwrap();
+    assert_eq!(model.dofs().eq(n10, 0), Some(9));
+    assert_eq!(model.dofs().eq(n10, 1), Some(10));
+    assert_eq!(
+        model.dofs().eq(n10, 2),
+        None,
+        "10.3 removed by a boundary condition"
+    );
+    assert_eq!(model.dofs().eq(n1, 0), Some(0));
+    // zeros are dropped: 11 diagonal + 10 off-diagonal
+    assert_eq!(model.k().compute_nnz(), 21);
+    let k = model.k().to_dense();
+    assert_eq!(k[(9, 10)], -1.0);
+    assert_eq!(k[(10, 10)], 15.0);
+    assert!((mesh.volume().unwrap() - 1.0 / 6.0).abs() < 1e-15);
+    assert_eq!(mesh.nsets["TOP"], vec![10]);
+    // "1.10" is node 1, direction 10, not "1.1"
+    let e = parse_calculix_dof("1.1\n1.10\n", "job.dof")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("job.dof:2") && e.contains("'1.10'") && e.contains("direction 10"),
+        "{e}"
+    );
+    // "10.1" and "1.10" differ too: a duplicate "1.1" is caught by the DOF map
+    let e = parse_calculix(&sti, &mas, "1.1\n1.1\n", inp, "dup")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("two equations") || e.contains("outside"), "{e}");
+}
+
+fn expect_err(r: Result<impl std::fmt::Debug, Error>, words: &[&str]) -> String {
+    let e = r.expect_err("an error was expected");
+    let msg = e.to_string();
+    for w in words {
+        assert!(msg.contains(w), "'{msg}' should mention '{w}'");
+    }
+    println!("{msg}");
+    msg
+}
+
+/// Each class of bad input gives a clear error naming the culprit.
+#[test]
+fn bad_input_catalogue() {
+    let (model, settings) = small_bar();
+    // mismatched sizes
+    let k = SparseColMat::<usize, f64>::try_new_from_triplets(9, 9, &[Triplet::new(0, 0, 1.0)])
+        .unwrap();
+    expect_err(
+        FeModel::new(
+            "m",
+            vec![1, 2, 3, 4],
+            vec![[0.0; 3]; 4],
+            DofMap::full(4),
+            k.as_ref(),
+            k.as_ref(),
+        ),
+        &["stiffness K is 9 × 9", "12 equations"],
+    );
+    // interface with fewer than 3 nodes / collinear nodes
+    let mut s = settings.clone();
+    s.interface_p = NodeSelection::Ids(vec![1, 2]);
+    expect_err(
+        build(&model, &s),
+        &["interface p", "2 node(s)", "3 non-collinear"],
+    );
+    let line: Vec<u64> = (0..model.n_nodes())
+        .filter(|&i| {
+            let c = model.coords()[i];
+            c[0] == 0.0 && c[2] == -0.003
+        })
+        .map(|i| model.node_ids()[i])
+        .collect();
+    s.interface_p = NodeSelection::Ids(line);
+    expect_err(build(&model, &s), &["interface p", "collinear"]);
+    // unknown node label
+    s.interface_p = NodeSelection::Ids(vec![1, 2, 999_999]);
+    expect_err(build(&model, &s), &["999999"]);
+    // a part not attached: a second, separate box
+    let two = Mesh::boxes(
+        &[
+            Block {
+                min: [0.0, -0.005, -0.003],
+                max: [0.05, 0.005, 0.003],
+                material: 0,
+            },
+            Block {
+                min: [0.1, -0.005, -0.003],
+                max: [0.11, 0.005, 0.003],
+                material: 0,
+            },
+        ],
+        &[steel()],
+        [0.0125, 0.005, 0.006],
+    )
+    .unwrap()
+    .assemble("two pieces")
+    .unwrap();
+    expect_err(
+        build(&two, &settings),
+        &["not attached", "not connected to interface p or q"],
+    );
+    // K not positive semi-definite
+    let kk = model.k();
+    let trip: Vec<Triplet<usize, usize, f64>> = (0..kk.ncols())
+        .flat_map(|j| {
+            kk.row_idx_of_col_raw(j)
+                .iter()
+                .zip(kk.val_of_col(j))
+                .map(move |(&i, &v)| Triplet::new(i, j, -v))
+        })
+        .collect();
+    let kneg =
+        SparseColMat::<usize, f64>::try_new_from_triplets(kk.nrows(), kk.ncols(), &trip).unwrap();
+    let neg = FeModel::new(
+        "negated",
+        model.node_ids().to_vec(),
+        model.coords().to_vec(),
+        model.dofs().clone(),
+        kneg.as_ref(),
+        model.m(),
+    )
+    .unwrap();
+    expect_err(
+        build(&neg, &settings),
+        &["not positive semi-definite", "node 1 ux"],
+    );
+    // units: coordinates in mm with SI matrices
+    let mut mm = model.clone();
+    mm.volume = Some(0.05 * 0.01 * 0.006 * 1e9);
+    expect_err(build(&mm, &settings), &["units", "density", "mm"]);
+    // linearly dependent modes: the same pattern twice
+    let nodes = NodeSelection::NearPlane {
+        point: [0.05, 0.0, 0.0],
+        normal: [1.0, 0.0, 0.0],
+        tolerance: 1e-9,
+    }
+    .resolve(&model, "q")
+    .unwrap();
+    let pts: Vec<[f64; 3]> = nodes.iter().map(|&i| model.coords()[i]).collect();
+    let pattern = InterfacePattern {
+        displacements: pts.iter().map(|p| [1e-3 * p[1] * p[1], 0.0, 0.0]).collect(),
+        points: pts.clone(),
+        tolerance: None,
+    };
+    let mut s = settings.clone();
+    for name in ["bulge", "bulge again"] {
+        s.interface_modes.push(InterfaceMode {
+            side: Side::Q,
+            name: name.into(),
+            pattern: pattern.clone(),
+        });
+    }
+    expect_err(build(&model, &s), &["linearly dependent", "'bulge again'"]);
+    // a rigid-body pattern
+    let mut s = settings.clone();
+    s.interface_modes.push(InterfaceMode {
+        side: Side::Q,
+        name: "shift".into(),
+        pattern: InterfacePattern {
+            displacements: vec![[1e-3, 0.0, 0.0]; pts.len()],
+            points: pts.clone(),
+            tolerance: None,
+        },
+    });
+    expect_err(build(&model, &s), &["shift", "rigid-body motion"]);
+    // point masses: rotary inertia on one node, two nodes
+    let inner: Vec<usize> = (0..model.n_nodes())
+        .filter(|&i| model.coords()[i][0] > 0.01 && model.coords()[i][0] < 0.04)
+        .collect();
+    let (n40, n41) = (inner[0], inner[1]);
+    let mut s = settings.clone();
+    s.point_masses.push(PointMass {
+        name: "coil".into(),
+        mass: 0.01,
+        position: model.coords()[n40],
+        inertia: Some([[1e-6, 0.0, 0.0], [0.0, 1e-6, 0.0], [0.0, 0.0, 1e-6]]),
+        nodes: NodeSelection::Ids(vec![model.node_ids()[n40]]),
+    });
+    expect_err(build(&model, &s), &["coil", "rotary inertia"]);
+    s.point_masses[0].nodes =
+        NodeSelection::Ids(vec![model.node_ids()[n40], model.node_ids()[n41]]);
+    expect_err(build(&model, &s), &["coil", "3 non-collinear"]);
+    // a parse error names file and line
+    let e = parse_calculix(
+        "1 1 x\n",
+        "1 1 1.0\n",
+        "1.1\n",
+        "*NODE\n1, 0, 0, 0\n",
+        "job",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("job.sti:1") && e.contains("bad value 'x'"),
+        "{e}"
+    );
+}
