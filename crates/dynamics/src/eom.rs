@@ -218,15 +218,25 @@ impl Dynamics {
             }
             if mass {
                 e.element.mass_matrix(&xl[..n], &mut ml[..n * n]);
-                for (a, ga) in e.x_index.iter().enumerate() {
+                // Mf[x_index, :] += M_e F_e, column by column (contiguous)
+                for c in 0..n_q {
+                    let fcol = fq.col_as_slice(c);
+                    let mut any = false;
                     for (b, gb) in e.x_index.iter().enumerate() {
-                        let m = ml[a * n + b];
-                        if m == 0.0 {
-                            continue;
+                        fl[b] = fcol[*gb];
+                        any |= fl[b] != 0.0;
+                    }
+                    if !any {
+                        continue;
+                    }
+                    let mcol = self.mf.col_as_slice_mut(c);
+                    for (a, ga) in e.x_index.iter().enumerate() {
+                        let row = &ml[a * n..a * n + n];
+                        let mut s = 0.0;
+                        for b in 0..n {
+                            s += row[b] * fl[b];
                         }
-                        for c in 0..n_q {
-                            self.mf[(*ga, c)] += m * fq[(*gb, c)];
-                        }
+                        mcol[*ga] += s;
                     }
                 }
             }
@@ -250,14 +260,9 @@ impl Dynamics {
         let fq = self.kin.f_xi();
         let eq = self.kin.e_xi();
         for c in 0..n_q {
-            let mut s = 0.0;
-            for i in 0..self.w.len() {
-                s += fq[(i, c)] * self.w[i];
-            }
-            for j in 0..self.sigma.len() {
-                s -= eq[(j, c)] * self.sigma[j];
-            }
-            self.rhs[c] = s;
+            let a: f64 = fq.col_as_slice(c).iter().zip(&self.w).map(|(f, w)| f * w).sum();
+            let b: f64 = eq.col_as_slice(c).iter().zip(&self.sigma).map(|(e, s)| e * s).sum();
+            self.rhs[c] = a - b;
         }
     }
 

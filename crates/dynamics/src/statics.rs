@@ -216,7 +216,7 @@ impl Dynamics {
                     break;
                 }
                 let mut dq: Vec<f64> = free.iter().map(|i| -g[*i]).collect();
-                lu.solve_vec(&mut dq);
+                lu.solve_vec(&mut dq, &mut Mat::zeros(free.len(), 1));
                 let qn = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 let dn = dq.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 for (k, i) in free.iter().enumerate() {

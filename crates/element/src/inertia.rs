@@ -255,46 +255,42 @@ impl SpatialInertia {
     }
 
     /// The mass matrix M = \[B; I\]ᵀ M̄ \[B; I\] (row-major, n × n with
-    /// n = 7·nodes + modes).
+    /// n = 7·nodes + modes). Each column of B̂ = \[B 0; 0 I\] has at most three
+    /// non-zeros, so M_ij = Σ B̂_ki M̄_kl B̂_lj costs at most nine products.
     pub fn mass(&self, x: &[f64], out: &mut [f64]) {
         let nxn = self.nx_nodes();
         let nv = self.nv();
         let nw = self.mbar.nrows();
         let n = nxn + nw - nv;
         let b = self.blocks(x);
-        // dense B̂ = [B 0; 0 I] (nw × n)
-        let mut bh = [[0.0f64; 14 + MAX_MODES]; MAX_W];
+        // sparse columns of B̂: (row, value) × up to 3
+        let mut cols = [[(0usize, 0.0f64); 3]; 14 + MAX_MODES];
+        let mut cnt = [0usize; 14 + MAX_MODES];
         for nd in 0..self.nodes {
-            for i in 0..3 {
-                for j in 0..3 {
-                    bh[6 * nd + i][7 * nd + j] = b.ft.0[i][j];
+            for j in 0..3 {
+                for i in 0..3 {
+                    cols[7 * nd + j][i] = (6 * nd + i, b.ft.0[i][j]);
                 }
-                for j in 0..4 {
-                    bh[6 * nd + 3 + i][7 * nd + 3 + j] = b.g[nd][i][j];
+                cnt[7 * nd + j] = 3;
+            }
+            for j in 0..4 {
+                for i in 0..3 {
+                    cols[7 * nd + 3 + j][i] = (6 * nd + 3 + i, b.g[nd][i][j]);
                 }
+                cnt[7 * nd + 3 + j] = 3;
             }
         }
         for i in nv..nw {
-            bh[i][nxn + i - nv] = 1.0;
-        }
-        // T = M̄ B̂ (nw × n), then M = B̂ᵀ T
-        let mut t = [[0.0f64; 14 + MAX_MODES]; MAX_W];
-        for i in 0..nw {
-            for k in 0..nw {
-                let m = self.mbar[(i, k)];
-                if m == 0.0 {
-                    continue;
-                }
-                for j in 0..n {
-                    t[i][j] += m * bh[k][j];
-                }
-            }
+            cols[nxn + i - nv][0] = (i, 1.0);
+            cnt[nxn + i - nv] = 1;
         }
         for i in 0..n {
             for j in i..n {
                 let mut s = 0.0;
-                for k in 0..nw {
-                    s += bh[k][i] * t[k][j];
+                for &(k, bk) in &cols[i][..cnt[i]] {
+                    for &(l, bl) in &cols[j][..cnt[j]] {
+                        s += bk * self.mbar[(k, l)] * bl;
+                    }
                 }
                 out[i * n + j] = s;
                 out[j * n + i] = s;

@@ -150,6 +150,10 @@ pub struct Kinematics {
     iterations: usize,
     x_good: Vec<f64>,
     xi_good: Vec<f64>,
+    lu_valid: bool,
+    dx: Vec<f64>,
+    col_buf: Mat<f64>,
+    rhs_vec: Vec<f64>,
 }
 
 impl Kinematics {
@@ -239,6 +243,10 @@ impl Kinematics {
             iterations: 0,
             x_good: mech.x0.clone(),
             xi_good: vec![0.0; n_xi],
+            lu_valid: false,
+            dx: vec![0.0; n_c],
+            col_buf: Mat::zeros(n_c, 1),
+            rhs_vec: vec![0.0; n_c],
             mech,
         };
         s.xi[..n_q].copy_from_slice(&s.mech.q0());
@@ -399,6 +407,7 @@ impl Kinematics {
                 self.xi_good.copy_from_slice(&self.xi);
             }
             Err(_) => {
+                self.lu_valid = false;
                 // back to the last converged configuration: the next solve
                 // (e.g. a retried, smaller step) starts from a good guess
                 self.x.copy_from_slice(&self.x_good);
@@ -456,6 +465,12 @@ impl Kinematics {
         let tol = self.opts.tol * self.length_scale.max(1e-6);
         let n_c = self.mech.constraint_rows.len();
         let mut last_update: Vec<f64> = vec![0.0; n_c];
+        // Newton with the Jacobian of the previous solve (chord steps) while it
+        // converges fast, refactorized when it does not and always at the
+        // converged point (F,ξ needs J there).
+        let mut factored_here = false;
+        let mut lu_fresh_for_steps = self.lu_valid;
+        let mut prev_res = f64::INFINITY;
         for it in 0..=self.opts.max_iterations {
             self.eval_elements(true);
             let mut res = 0.0f64;
@@ -467,22 +482,27 @@ impl Kinematics {
             if !res.is_finite() {
                 break;
             }
-            self.assemble_jacobian();
-            if !self.lu.factor(self.jmat.as_ref()) {
-                return Err(self.singular_error());
-            }
             // converged: residual below tolerance, or Newton updates at rounding
             // level while the residual is small (it cannot decrease further)
-            let x_scale = self
-                .mech
-                .dependent
-                .iter()
-                .fold(1.0f64, |m, &i| m.max(self.x[i].abs()));
+            let x_scale = self.mech.dependent.iter().fold(1.0f64, |m, &i| m.max(self.x[i].abs()));
             let stalled = it > 0
-                && last_update.iter().fold(0.0f64, |m, v| m.max(v.abs()))
-                    <= 8.0 * f64::EPSILON * x_scale
+                && last_update.iter().fold(0.0f64, |m, v| m.max(v.abs())) <= 8.0 * f64::EPSILON * x_scale
                 && res <= 1e3 * tol.max(1e-300);
-            if res <= tol || stalled {
+            let converged = res <= tol || stalled;
+            // a fresh factorization at this x: at convergence, at the start
+            // without a usable one, or when chord steps converge slowly
+            if converged || !lu_fresh_for_steps || (it > 0 && res > 0.1 * prev_res) {
+                self.assemble_jacobian();
+                if !self.lu.factor(self.jmat.as_ref()) {
+                    self.lu_valid = false;
+                    return Err(self.singular_error());
+                }
+                self.lu_valid = true;
+                lu_fresh_for_steps = true;
+                factored_here = true;
+            }
+            if converged {
+                debug_assert!(factored_here);
                 self.iterations = it;
                 self.prev_eps.copy_from_slice(&self.eps);
                 self.have_solution = true;
@@ -491,9 +511,11 @@ impl Kinematics {
             if it == self.opts.max_iterations {
                 break;
             }
-            let mut dx = self.work[..n_c].to_vec();
-            self.lu.solve_vec(&mut dx);
-            // Newton step with backtracking: halve while the residual grows
+            prev_res = res;
+            self.dx[..n_c].copy_from_slice(&self.work[..n_c]);
+            self.lu.solve_vec(&mut self.dx[..n_c], &mut self.col_buf);
+            let dx = std::mem::take(&mut self.dx);
+            // step with backtracking: halve while the residual grows
             let mut step = 1.0;
             for _ in 0..6 {
                 for (k, &i) in self.mech.dependent.iter().enumerate() {
@@ -516,7 +538,11 @@ impl Kinematics {
                     break;
                 }
             }
-            last_update = dx.iter().map(|v| v * step).collect();
+            for (k, u) in last_update.iter_mut().enumerate() {
+                *u = dx[k] * step;
+            }
+            self.dx = dx;
+            factored_here = false;
         }
         // failure report
         let mut eq: Vec<(f64, String)> = self
@@ -589,9 +615,11 @@ impl Kinematics {
         }
         self.lu.solve_in_place(self.rhs.as_mut());
         self.f.fill(0.0);
-        for (k, &i) in self.mech.dependent.iter().enumerate() {
-            for c in 0..n_xi {
-                self.f[(i, c)] = self.rhs[(k, c)];
+        for c in 0..n_xi {
+            let src = self.rhs.col_as_slice(c);
+            let dst = self.f.col_as_slice_mut(c);
+            for (k, &i) in self.mech.dependent.iter().enumerate() {
+                dst[i] = src[k];
             }
         }
         for (i, k) in self.xi_of_x.iter().enumerate() {
@@ -601,25 +629,26 @@ impl Kinematics {
         }
         // E,ξ = D,x F,ξ; exact for rigid / DOF / input rows
         self.e.fill(0.0);
-        for (ei, e) in self.mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
-            for a in 0..m.ne {
-                let j = e.eps_offset + a;
-                if self.row_of[j].is_some() {
-                    if let Some(k) = self.xi_of_e[j] {
-                        self.e[(j, k)] = 1.0;
-                    }
-                    continue;
-                }
-                for (c, gi) in e.x_index.iter().enumerate() {
-                    let d = jl[a * m.nx + c];
-                    if d == 0.0 {
+        for col in 0..n_xi {
+            let fcol = self.f.col_as_slice(col);
+            let ecol = self.e.col_as_slice_mut(col);
+            for (ei, e) in self.mech.elements.iter().enumerate() {
+                let m = &self.maps[ei];
+                let jl = &self.jac_local[ei];
+                for a in 0..m.ne {
+                    let j = e.eps_offset + a;
+                    if self.row_of[j].is_some() {
+                        if self.xi_of_e[j] == Some(col) {
+                            ecol[j] = 1.0;
+                        }
                         continue;
                     }
-                    for col in 0..n_xi {
-                        self.e[(j, col)] += d * self.f[(*gi, col)];
+                    let row = &jl[a * m.nx..(a + 1) * m.nx];
+                    let mut s = 0.0;
+                    for (c, gi) in e.x_index.iter().enumerate() {
+                        s += row[c] * fcol[*gi];
                     }
+                    ecol[j] = s;
                 }
             }
         }
@@ -634,19 +663,19 @@ impl Kinematics {
             self.xid[n_q + k] = self.mech.inputs[k].function.eval(self.t).1;
         }
         let n_xi = n_q + n_u;
-        for i in 0..self.xd.len() {
-            let mut s = 0.0;
-            for c in 0..n_xi {
-                s += self.f[(i, c)] * self.xid[c];
+        self.xd.fill(0.0);
+        self.epsd.fill(0.0);
+        for c in 0..n_xi {
+            let v = self.xid[c];
+            if v == 0.0 {
+                continue;
             }
-            self.xd[i] = s;
-        }
-        for j in 0..self.epsd.len() {
-            let mut s = 0.0;
-            for c in 0..n_xi {
-                s += self.e[(j, c)] * self.xid[c];
+            for (d, f) in self.xd.iter_mut().zip(self.f.col_as_slice(c)) {
+                *d += f * v;
             }
-            self.epsd[j] = s;
+            for (d, e) in self.epsd.iter_mut().zip(self.e.col_as_slice(c)) {
+                *d += e * v;
+            }
         }
     }
 
@@ -655,13 +684,13 @@ impl Kinematics {
     /// [`velocities`](Self::velocities). Then ẍ = F,q q̈ + ẍ0.
     pub fn accelerations(&mut self) {
         let n_u = self.n_u;
-        let n_c = self.mech.constraint_rows.len();
         let mech = self.mech.clone();
         // c = D,xx[ẋ, ẋ] per element
         let mut xl = [0.0; 64];
         let mut vl = [0.0; 64];
         let mut c = [0.0; 64];
-        let mut rhs = vec![0.0; n_c];
+        let mut rhs = std::mem::take(&mut self.rhs_vec);
+        rhs.fill(0.0);
         for (ei, e) in mech.elements.iter().enumerate() {
             let m = &self.maps[ei];
             if m.ne == 0 {
@@ -714,7 +743,7 @@ impl Kinematics {
                 }
             }
         }
-        self.lu.solve_vec(&mut rhs);
+        self.lu.solve_vec(&mut rhs, &mut self.col_buf);
         self.xdd0.fill(0.0);
         for (k, &i) in mech.dependent.iter().enumerate() {
             self.xdd0[i] = rhs[k];
@@ -744,6 +773,7 @@ impl Kinematics {
                 self.epsdd0[j] = s;
             }
         }
+        self.rhs_vec = rhs;
     }
 
     /// The contraction G = F,qqᵀ w + E,qqᵀ σ (n_q × n_q, symmetric), the
@@ -774,7 +804,8 @@ impl Kinematics {
                 }
             }
         }
-        self.lu.solve_transpose_vec(&mut y);
+        let mut buf = Mat::zeros(y.len(), 1);
+        self.lu.solve_transpose_vec(&mut y, &mut buf);
         let mu = y;
         let mut g = Mat::<f64>::zeros(n_q, n_q);
         let mut xl = [0.0; 64];

@@ -65,22 +65,18 @@ impl DenseLu {
             }
         }
     }
-    /// Solves A x = b for a vector.
-    pub fn solve_vec(&self, b: &mut [f64]) {
+    /// Solves A x = b for a vector, using `buf` (n × 1) as work space.
+    pub fn solve_vec(&self, b: &mut [f64], buf: &mut Mat<f64>) {
         let n = b.len();
-        let mut m = Mat::from_fn(n, 1, |i, _| b[i]);
-        self.solve_in_place(m.as_mut());
-        for (i, v) in b.iter_mut().enumerate() {
-            *v = m[(i, 0)];
-        }
+        buf.col_as_slice_mut(0)[..n].copy_from_slice(b);
+        self.solve_in_place(buf.as_mut().subrows_mut(0, n));
+        b.copy_from_slice(&buf.col_as_slice(0)[..n]);
     }
-    /// Solves Aᵀ x = b for a vector.
-    pub fn solve_transpose_vec(&self, b: &mut [f64]) {
+    /// Solves Aᵀ x = b for a vector, using `buf` (n × 1) as work space.
+    pub fn solve_transpose_vec(&self, b: &mut [f64], buf: &mut Mat<f64>) {
         let n = b.len();
-        let mut m = Mat::from_fn(n, 1, |i, _| b[i]);
-        self.solve_transpose_in_place(m.as_mut());
-        for (i, v) in b.iter_mut().enumerate() {
-            *v = m[(i, 0)];
-        }
+        buf.col_as_slice_mut(0)[..n].copy_from_slice(b);
+        self.solve_transpose_in_place(buf.as_mut().subrows_mut(0, n));
+        b.copy_from_slice(&buf.col_as_slice(0)[..n]);
     }
 }
