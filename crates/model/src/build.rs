@@ -73,9 +73,28 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
     // ---- nodes
     let mut node_at: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut node_order: Vec<String> = vec![];
+    let mut shares: HashMap<String, String> = HashMap::new();
     for n in &scene.nodes {
         if n.id.is_empty() {
             return Err(ModelError::invalid("node", "an empty id"));
+        }
+        let mut n = n.clone();
+        if let Some(other) = &n.position_of {
+            let at = node_at.get(other).cloned().ok_or_else(|| ModelError::UnknownId {
+                kind: "node",
+                id: other.clone(),
+                context: format!("node '{}' position_of (name an earlier node)", n.id),
+                hint: closest(other, node_at.keys()),
+            })?;
+            if !n.at.is_empty() && n.at != at {
+                return Err(ModelError::invalid(
+                    format!("node '{}'", n.id),
+                    format!("gives a position {:?} different from that of '{other}' {:?}", n.at, at),
+                ));
+            }
+            n.at = at;
+            let root = shares.get(other).cloned().unwrap_or_else(|| other.clone());
+            shares.insert(n.id.clone(), root);
         }
         if n.at.len() != nd {
             return Err(ModelError::invalid(
@@ -476,13 +495,21 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
     let mut nodes = vec![];
     let mut x0 = vec![];
     let mut x_names = vec![];
+    let mut position_of_node: HashMap<String, Vec<usize>> = HashMap::new();
     for id in &node_order {
         let at = node_at[id].clone();
-        let position: Vec<usize> = (0..nd).map(|k| x0.len() + k).collect();
-        for (k, c) in ["x", "y", "z"].iter().take(nd).enumerate() {
-            x0.push(at[k]);
-            x_names.push(format!("{id}.{c}"));
-        }
+        let position: Vec<usize> = match shares.get(id) {
+            Some(root) => position_of_node[root].clone(),
+            None => {
+                let p: Vec<usize> = (0..nd).map(|k| x0.len() + k).collect();
+                for (k, c) in ["x", "y", "z"].iter().take(nd).enumerate() {
+                    x0.push(at[k]);
+                    x_names.push(format!("{id}.{c}"));
+                }
+                p
+            }
+        };
+        position_of_node.insert(id.clone(), position.clone());
         let orientation = if needs_orient.get(id).copied().unwrap_or(false) {
             let start = x0.len();
             match dim {

@@ -58,12 +58,19 @@ pub enum SectionSpec {
 }
 
 /// A node: its id and reference position (2 or 3 components).
+///
+/// A node may share the position coordinates of another node while having its
+/// own orientation (`position_of`): two bodies joined by a hinge at one point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NodeSpec {
     /// Unique id.
     pub id: String,
-    /// Reference position (m).
+    /// Reference position (m); may be omitted with `position_of`.
+    #[serde(default)]
     pub at: Vec<f64>,
+    /// Share the position coordinates of this (earlier) node.
+    #[serde(default)]
+    pub position_of: Option<String>,
 }
 
 fn default_true() -> bool {
