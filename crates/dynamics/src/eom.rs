@@ -17,6 +17,12 @@ pub struct Energies {
     pub kinetic: f64,
     /// Elastic energy ½εᵀSε (+ σ0ᵀε) of the non-rigid deformations.
     pub elastic: f64,
+    /// Gravitational potential of the elements that have an exact one (point
+    /// masses); see `gravity_exact`.
+    pub gravitational: f64,
+    /// True when every massive element contributed an exact potential; else
+    /// use the integrated external work for energy balances.
+    pub gravity_exact: bool,
 }
 
 /// The dynamics of one mechanism: kinematics plus forces; holds all buffers.
@@ -260,8 +266,18 @@ impl Dynamics {
         let fq = self.kin.f_xi();
         let eq = self.kin.e_xi();
         for c in 0..n_q {
-            let a: f64 = fq.col_as_slice(c).iter().zip(&self.w).map(|(f, w)| f * w).sum();
-            let b: f64 = eq.col_as_slice(c).iter().zip(&self.sigma).map(|(e, s)| e * s).sum();
+            let a: f64 = fq
+                .col_as_slice(c)
+                .iter()
+                .zip(&self.w)
+                .map(|(f, w)| f * w)
+                .sum();
+            let b: f64 = eq
+                .col_as_slice(c)
+                .iter()
+                .zip(&self.sigma)
+                .map(|(e, s)| e * s)
+                .sum();
             self.rhs[c] = a - b;
         }
     }
@@ -346,7 +362,10 @@ impl Dynamics {
         self.kinematics_at(t, q, Some(qd))?;
         let mech = self.mech.clone();
         let (x, xd, eps) = (self.kin.x(), self.kin.xd(), self.kin.eps());
-        let mut en = Energies::default();
+        let mut en = Energies {
+            gravity_exact: true,
+            ..Default::default()
+        };
         let mut xl = [0.0; 64];
         let mut vl = [0.0; 64];
         for e in &mech.elements {
@@ -357,6 +376,12 @@ impl Dynamics {
             }
             if e.element.has_inertia() {
                 en.kinetic += e.element.kinetic_energy(&xl[..n], &vl[..n]);
+                if let Some(g) = mech.gravity {
+                    match e.element.gravity_potential(&xl[..n], &g) {
+                        Some(v) => en.gravitational += v,
+                        None => en.gravity_exact = false,
+                    }
+                }
             }
             let ne = e.element.n_eps();
             if ne > 0 {
@@ -368,6 +393,43 @@ impl Dynamics {
             }
         }
         Ok(en)
+    }
+
+    /// Initial q̇ from the scene's initial nodal velocities (rigid-body fields),
+    /// by least squares on F,q q̇ = ẋ0 − F,u u̇ at the configuration q0.
+    pub fn initial_qd(&mut self, t: f64, q0: &[f64]) -> Result<Vec<f64>, DynamicsError> {
+        let n_q = self.n_q();
+        self.kinematics_at(t, q0, None)?;
+        self.kin.velocities(&vec![0.0; n_q]);
+        let f = self.kin.f_xi();
+        let target: Vec<f64> = self
+            .mech
+            .initial_xd
+            .iter()
+            .zip(self.kin.xd())
+            .map(|(a, b)| a - b)
+            .collect();
+        let a = Mat::from_fn(n_q, n_q, |r, c| {
+            f.col_as_slice(r)
+                .iter()
+                .zip(f.col_as_slice(c))
+                .map(|(x, y)| x * y)
+                .sum::<f64>()
+        });
+        let mut b = Mat::from_fn(n_q, 1, |r, _| {
+            f.col_as_slice(r)
+                .iter()
+                .zip(&target)
+                .map(|(x, y)| x * y)
+                .sum::<f64>()
+        });
+        if n_q > 0 {
+            let llt = a
+                .llt(faer::Side::Lower)
+                .map_err(|_| DynamicsError::Invalid("F,q is rank deficient".into()))?;
+            llt.solve_in_place(b.as_mut());
+        }
+        Ok((0..n_q).map(|i| b[(i, 0)]).collect())
     }
 
     /// Power of the external forces (loads, gravity, controllers) at (q, q̇, t):

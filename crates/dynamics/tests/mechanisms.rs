@@ -9,11 +9,19 @@ use std::path::Path;
 use std::sync::Arc;
 
 fn scene(name: &str) -> Scene {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenes").join(name);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes")
+        .join(name);
     Scene::load(&p).unwrap()
 }
 
-fn node_coordinate_history(mech: &Arc<Mechanism>, t: &[f64], q: &[Vec<f64>], node: &str, k: usize) -> Vec<f64> {
+fn node_coordinate_history(
+    mech: &Arc<Mechanism>,
+    t: &[f64],
+    q: &[Vec<f64>],
+    node: &str,
+    k: usize,
+) -> Vec<f64> {
     let idx = mech.node(node).unwrap().position[k];
     let mut kin = Kinematics::new(mech.clone());
     t.iter()
@@ -33,11 +41,22 @@ fn planar_straight_guidance_reaches_the_thesis_deflection() {
     let mut dy = Dynamics::new(mech.clone());
     let q0 = mech.q0();
     let opts = SimulationOptions::new(Integrator::Dopri5, 0.0, 0.5, 501);
-    let tr = dy.simulate(0.0, &q0, &vec![0.0; q0.len()], &opts, |_, _, _| Control::Continue).unwrap();
+    let tr = dy
+        .simulate(0.0, &q0, &vec![0.0; q0.len()], &opts, |_, _, _| {
+            Control::Continue
+        })
+        .unwrap();
     let x0 = mech.node("S").unwrap().at[0];
     let xs = node_coordinate_history(&mech, &tr.t, &tr.q, "S", 0);
-    let max = xs.iter().map(|x| x - x0).fold(0.0f64, |m, v| m.max(v.abs()));
-    assert!((max / 0.0833 - 1.0).abs() < 0.01, "max x-deflection {max} m vs 0.0833 m ({} evaluations)", tr.stats.rhs_evals);
+    let max = xs
+        .iter()
+        .map(|x| x - x0)
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(
+        (max / 0.0833 - 1.0).abs() < 0.01,
+        "max x-deflection {max} m vs 0.0833 m ({} evaluations)",
+        tr.stats.rhs_evals
+    );
 }
 
 #[test]
@@ -48,18 +67,30 @@ fn spatial_straight_guidance_statics_under_gravity_and_response() {
     let mech = Arc::new(scene("straight_guidance_spatial.ron").build(None).unwrap());
     let mut dy = Dynamics::new(mech.clone());
     let q0 = mech.q0();
-    let st = dy.static_equilibrium(0.0, &q0, &StaticOptions::default()).unwrap();
+    let st = dy
+        .static_equilibrium(0.0, &q0, &StaticOptions::default())
+        .unwrap();
     // the gravity sag of the body: small and downwards
     let zs = node_coordinate_history(&mech, &[0.0], std::slice::from_ref(&st.q), "S", 2)[0];
     assert!(zs < 0.0 && zs > -1e-3, "static z of S under gravity: {zs}");
     let mut opts = SimulationOptions::new(Integrator::GeneralizedAlpha, 0.0, 0.3, 301);
     opts.rtol = 1e-5;
     opts.atol = 1e-8;
-    let tr = dy.simulate(0.0, &st.q, &vec![0.0; q0.len()], &opts, |_, _, _| Control::Continue).unwrap();
+    let tr = dy
+        .simulate(0.0, &st.q, &vec![0.0; q0.len()], &opts, |_, _, _| {
+            Control::Continue
+        })
+        .unwrap();
     let x0 = mech.node("S").unwrap().at[0];
     let xs = node_coordinate_history(&mech, &tr.t, &tr.q, "S", 0);
-    let max = xs.iter().map(|x| x - x0).fold(0.0f64, |m, v| m.max(v.abs()));
-    assert!((max / 0.0834 - 1.0).abs() < 0.01, "max x-deflection {max} m vs 0.0834 m");
+    let max = xs
+        .iter()
+        .map(|x| x - x0)
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(
+        (max / 0.0834 - 1.0).abs() < 0.01,
+        "max x-deflection {max} m vs 0.0834 m"
+    );
 }
 
 #[test]
@@ -71,18 +102,31 @@ fn two_link_manipulator_runs_and_tracks_its_reference() {
     let mut dy = Dynamics::new(mech.clone());
     let q0 = mech.q0();
     let opts = SimulationOptions::new(Integrator::Dopri5, 0.0, 0.7, 141);
-    let tr = dy.simulate(0.0, &q0, &vec![0.0; q0.len()], &opts, |_, _, _| Control::Continue).unwrap();
+    let tr = dy
+        .simulate(0.0, &q0, &vec![0.0; q0.len()], &opts, |_, _, _| {
+            Control::Continue
+        })
+        .unwrap();
     assert_eq!(tr.t.len(), 141);
     let mut kin = Kinematics::new(mech.clone());
     let mut worst = 0.0f64;
     for (t, q) in tr.t.iter().zip(&tr.q) {
         kin.solve(q, *t).unwrap();
         for c in &mech.controllers {
-            let flexmb_model::Coordinate::Def(j) = c.on else { unreachable!() };
+            let flexmb_model::Coordinate::Def(j) = c.on else {
+                unreachable!()
+            };
             worst = worst.max((kin.eps()[j] - c.reference.value(*t)).abs());
         }
     }
     // a P-controlled 5 Hz closed loop overshoots a 90° move by less than 0.15 rad
-    assert!(worst < 0.15, "joint tracking error up to {worst} rad ({} evaluations)", tr.stats.rhs_evals);
-    assert!(worst > 1e-3, "a flexible, P-controlled manipulator cannot track exactly");
+    assert!(
+        worst < 0.15,
+        "joint tracking error up to {worst} rad ({} evaluations)",
+        tr.stats.rhs_evals
+    );
+    assert!(
+        worst > 1e-3,
+        "a flexible, P-controlled manipulator cannot track exactly"
+    );
 }

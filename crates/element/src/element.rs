@@ -957,6 +957,18 @@ impl Element {
         }
     }
 
+    /// The exact gravitational potential −m g·r_c where the element's centre
+    /// of mass follows from its coordinates exactly (point masses); `None` for
+    /// elements whose consistent gravity force has no closed-form potential here.
+    pub fn gravity_potential(&self, x: &[f64], g: &[f64; 3]) -> Option<f64> {
+        match &self.kind {
+            Kind::PointMass { m } => Some(-m * (g[0] * x[0] + g[1] * x[1] + g[2] * x[2])),
+            Kind::PlanarMass { m, .. } => Some(-m * (g[0] * x[0] + g[1] * x[1])),
+            _ if !self.has_inertia() => Some(0.0),
+            _ => None,
+        }
+    }
+
     /// Kinetic energy T(x, ẋ).
     pub fn kinetic_energy(&self, x: &[f64], xd: &[f64]) -> f64 {
         match &self.kind {

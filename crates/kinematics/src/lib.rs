@@ -89,6 +89,15 @@ pub enum KinematicsError {
         /// Coordinates in the null space.
         coordinates: Vec<String>,
     },
+    /// The dependent Euler parameter of a node with the other three as DOFs
+    /// approaches zero: the parametrization is singular there.
+    #[error("{coordinate} = {value:.3}, the Euler parameter made dependent by the normalization, approaches zero (a rotation near 180° from the reference): this choice of nodal DOFs cannot describe it; use deformation DOFs or another dependent component")]
+    EulerParameterDegenerate {
+        /// The coordinate.
+        coordinate: String,
+        /// Its value.
+        value: f64,
+    },
     /// Non-finite input.
     #[error("non-finite value in {what} at index {index}")]
     NonFinite {
@@ -349,6 +358,32 @@ impl Kinematics {
         }
     }
 
+    /// Fails when a node's only dependent Euler parameter nears zero.
+    fn check_euler_parameters(&self) -> Result<(), KinematicsError> {
+        for n in &self.mech.nodes {
+            let Some(o) = &n.orientation else { continue };
+            if o.len() != 4 {
+                continue;
+            }
+            let deps: Vec<usize> = o
+                .iter()
+                .copied()
+                .filter(|i| matches!(self.mech.x_roles[*i], XRole::Dependent(_)))
+                .collect();
+            let dofs = o
+                .iter()
+                .filter(|i| matches!(self.mech.x_roles[**i], XRole::Dof(_)))
+                .count();
+            if deps.len() == 1 && dofs == 3 && self.x[deps[0]].abs() < 0.05 {
+                return Err(KinematicsError::EulerParameterDegenerate {
+                    coordinate: self.mech.x_names[deps[0]].clone(),
+                    value: self.x[deps[0]],
+                });
+            }
+        }
+        Ok(())
+    }
+
     fn residual_norm(&self) -> f64 {
         self.mech
             .constraint_rows
@@ -484,9 +519,14 @@ impl Kinematics {
             }
             // converged: residual below tolerance, or Newton updates at rounding
             // level while the residual is small (it cannot decrease further)
-            let x_scale = self.mech.dependent.iter().fold(1.0f64, |m, &i| m.max(self.x[i].abs()));
+            let x_scale = self
+                .mech
+                .dependent
+                .iter()
+                .fold(1.0f64, |m, &i| m.max(self.x[i].abs()));
             let stalled = it > 0
-                && last_update.iter().fold(0.0f64, |m, v| m.max(v.abs())) <= 8.0 * f64::EPSILON * x_scale
+                && last_update.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+                    <= 8.0 * f64::EPSILON * x_scale
                 && res <= 1e3 * tol.max(1e-300);
             let converged = res <= tol || stalled;
             // a fresh factorization at this x: at convergence, at the start
@@ -503,6 +543,7 @@ impl Kinematics {
             }
             if converged {
                 debug_assert!(factored_here);
+                self.check_euler_parameters()?;
                 self.iterations = it;
                 self.prev_eps.copy_from_slice(&self.eps);
                 self.have_solution = true;

@@ -80,16 +80,22 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
         }
         let mut n = n.clone();
         if let Some(other) = &n.position_of {
-            let at = node_at.get(other).cloned().ok_or_else(|| ModelError::UnknownId {
-                kind: "node",
-                id: other.clone(),
-                context: format!("node '{}' position_of (name an earlier node)", n.id),
-                hint: closest(other, node_at.keys()),
-            })?;
+            let at = node_at
+                .get(other)
+                .cloned()
+                .ok_or_else(|| ModelError::UnknownId {
+                    kind: "node",
+                    id: other.clone(),
+                    context: format!("node '{}' position_of (name an earlier node)", n.id),
+                    hint: closest(other, node_at.keys()),
+                })?;
             if !n.at.is_empty() && n.at != at {
                 return Err(ModelError::invalid(
                     format!("node '{}'", n.id),
-                    format!("gives a position {:?} different from that of '{other}' {:?}", n.at, at),
+                    format!(
+                        "gives a position {:?} different from that of '{other}' {:?}",
+                        n.at, at
+                    ),
                 ));
             }
             n.at = at;

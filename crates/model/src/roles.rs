@@ -352,30 +352,31 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
     let project_x = |i: usize| -> Vec<f64> { (0..d).map(|k| null[(free_pos[&i], k)]).collect() };
     let mut chosen: Vec<Coordinate> = vec![];
     let nodal_candidates = |mech: &Mechanism| -> Vec<usize> {
-        // planar angles first (a pinned link is best described by its angle),
-        // then positions, then Euler parameters with the largest reference
-        // value last (it becomes the dependent one), then mode amplitudes
-        let mut angles = vec![];
+        // node by node: a planar angle first (a pinned link is best described by
+        // its angle), then the position, then Euler parameters with the largest
+        // reference value last (it becomes the dependent one); so a free body's
+        // motion is described by one node's position and orientation rather than
+        // by positions of other nodes (which become singular at 90°). Then modes.
         let mut v = vec![];
-        let mut orient = vec![];
         for n in &mech.nodes {
-            v.extend(n.position.iter().copied());
             match &n.orientation {
-                Some(o) if o.len() == 1 => angles.push(o[0]),
+                Some(o) if o.len() == 1 => {
+                    v.push(o[0]);
+                    v.extend(n.position.iter().copied());
+                }
                 Some(o) => {
+                    v.extend(n.position.iter().copied());
                     let mut o = o.clone();
                     o.sort_by(|a, b| mech.x0[*a].abs().total_cmp(&mech.x0[*b].abs()));
-                    orient.extend(o);
+                    v.extend(o);
                 }
-                None => {}
+                None => v.extend(n.position.iter().copied()),
             }
         }
-        angles.extend(v);
-        angles.extend(orient);
         for (_, g) in &mech.mode_groups {
-            angles.extend(g.iter().copied());
+            v.extend(g.iter().copied());
         }
-        angles.into_iter().filter(|i| xr[*i] == R::Free).collect()
+        v.into_iter().filter(|i| xr[*i] == R::Free).collect()
     };
     match &scene.dofs {
         DofChoice::Deformations | DofChoice::NodalCoordinates => {
