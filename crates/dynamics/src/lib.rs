@@ -35,11 +35,13 @@
 #![warn(missing_docs)]
 
 mod eom;
+mod outputs;
 mod simulate;
 mod statics;
 
 pub use eom::{Dynamics, Energies};
 pub use flexmb_ode::{Control, Stats};
+pub use outputs::OutputTable;
 pub use simulate::{FirstOrder, Integrator, SimulationOptions, Trajectory};
 pub use statics::{StaticOptions, StaticSolution};
 

@@ -1,0 +1,155 @@
+//! The outputs a scene asks for (node positions and rotations, deformations,
+//! stress resultants, energies, DOFs), as named columns of a table.
+
+use crate::{Dynamics, DynamicsError};
+use flexmb_model::OutputSpec;
+use flexmb_rotation::EulerParameters;
+
+enum Column {
+    X(usize),
+    Eps(usize),
+    Sigma(usize),
+    RotVec(usize, [usize; 4]),
+    Kinetic,
+    Elastic,
+    Gravitational,
+    Q(usize),
+}
+
+/// A recorder of the requested outputs.
+pub struct OutputTable {
+    columns: Vec<Column>,
+    /// Column names.
+    pub header: Vec<String>,
+}
+
+impl OutputTable {
+    /// The columns for the mechanism's requested outputs (DOFs if none are requested).
+    pub fn new(dy: &Dynamics) -> Result<Self, DynamicsError> {
+        let m = dy.mechanism().clone();
+        let mut columns = vec![];
+        let mut header = vec![];
+        let mut specs = m.outputs.clone();
+        if specs.is_empty() {
+            specs.push(OutputSpec::Dofs);
+        }
+        let unknown =
+            |what: &str, id: &str| DynamicsError::Invalid(format!("output: unknown {what} '{id}'"));
+        for s in &specs {
+            match s {
+                OutputSpec::Position(id) => {
+                    let n = m.node(id).ok_or_else(|| unknown("node", id))?;
+                    for (k, i) in n.position.iter().enumerate() {
+                        columns.push(Column::X(*i));
+                        header.push(format!("{id}.{}", ["x", "y", "z"][k]));
+                    }
+                }
+                OutputSpec::Rotation(id) => {
+                    let n = m.node(id).ok_or_else(|| unknown("node", id))?;
+                    match &n.orientation {
+                        Some(o) if o.len() == 1 => {
+                            columns.push(Column::X(o[0]));
+                            header.push(format!("{id}.angle"));
+                        }
+                        Some(o) => {
+                            for k in 0..3 {
+                                columns.push(Column::RotVec(k, [o[0], o[1], o[2], o[3]]));
+                                header.push(format!("{id}.rotvec_{}", ["x", "y", "z"][k]));
+                            }
+                        }
+                        None => {
+                            return Err(DynamicsError::Invalid(format!(
+                                "output: node '{id}' has no rotation"
+                            )))
+                        }
+                    }
+                }
+                OutputSpec::Deformation(eid, name) | OutputSpec::Stress(eid, name) => {
+                    let stress = matches!(s, OutputSpec::Stress(..));
+                    let mut found = false;
+                    for e in m
+                        .elements
+                        .iter()
+                        .filter(|e| e.id == *eid || e.group == *eid)
+                    {
+                        for (k, n) in e.element.deformation_names().iter().enumerate() {
+                            if name == "*" || n == name {
+                                found = true;
+                                let j = e.eps_offset + k;
+                                columns.push(if stress {
+                                    Column::Sigma(j)
+                                } else {
+                                    Column::Eps(j)
+                                });
+                                header.push(format!(
+                                    "{}{}",
+                                    if stress { "sigma:" } else { "" },
+                                    m.eps_names[j]
+                                ));
+                            }
+                        }
+                    }
+                    if !found {
+                        return Err(DynamicsError::Invalid(format!(
+                            "output: no deformation '{name}' in element '{eid}'"
+                        )));
+                    }
+                }
+                OutputSpec::Energies => {
+                    columns.extend([Column::Kinetic, Column::Elastic, Column::Gravitational]);
+                    header.extend([
+                        "kinetic".to_string(),
+                        "elastic".into(),
+                        "gravitational".into(),
+                    ]);
+                }
+                OutputSpec::Dofs => {
+                    for (k, c) in m.dofs.iter().enumerate() {
+                        columns.push(Column::Q(k));
+                        header.push(format!("q:{}", m.coordinate_name(*c)));
+                    }
+                }
+            }
+        }
+        Ok(Self { columns, header })
+    }
+
+    /// One row at (t, q, q̇).
+    pub fn row(
+        &self,
+        dy: &mut Dynamics,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+    ) -> Result<Vec<f64>, DynamicsError> {
+        let needs_energy = self
+            .columns
+            .iter()
+            .any(|c| matches!(c, Column::Kinetic | Column::Elastic | Column::Gravitational));
+        let en = if needs_energy {
+            Some(dy.energies(t, q, qd)?)
+        } else {
+            None
+        };
+        dy.kinematics_at(t, q, Some(qd))?;
+        dy.forces(t, true);
+        let x = dy.kin.x();
+        let eps = dy.kin.eps();
+        Ok(self
+            .columns
+            .iter()
+            .map(|c| match c {
+                Column::X(i) => x[*i],
+                Column::Eps(j) => eps[*j],
+                Column::Sigma(j) => dy.sigma[*j],
+                Column::RotVec(k, o) => {
+                    EulerParameters([x[o[0]], x[o[1]], x[o[2]], x[o[3]]]).to_rotation_vector()[*k]
+                }
+                Column::Kinetic => en.map_or(0.0, |e| e.kinetic),
+                Column::Elastic => en.map_or(0.0, |e| e.elastic),
+                Column::Gravitational => en.map_or(0.0, |e| e.gravitational),
+                Column::Q(k) => q[*k],
+            })
+            .collect())
+    }
+}
