@@ -35,12 +35,14 @@
 #![warn(missing_docs)]
 
 mod eom;
+mod linearize;
 mod outputs;
 mod simulate;
 mod statics;
 
 pub use eom::{Dynamics, Energies};
 pub use flexmb_ode::{Control, Stats};
+pub use linearize::Linearization;
 pub use outputs::OutputTable;
 pub use simulate::{FirstOrder, Integrator, SimulationOptions, Trajectory};
 pub use statics::{StaticOptions, StaticSolution};

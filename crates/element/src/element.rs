@@ -9,8 +9,9 @@ use crate::beam_matrices::{
 };
 use crate::inertia::{PlanarInertia, SpatialInertia, VelocityTransform, MAX_MODES};
 use crate::kernels::{
-    jacobian, second_directional, weighted_hessian, DefKernel, NormalizationKernel,
-    PlanarBeamKernel, PlanarHingeKernel, SpatialHingeKernel, TrussKernel, TwoNodeSpatial,
+    jacobian, second_directional, third_directional, weighted_hessian, DefKernel,
+    NormalizationKernel, PlanarBeamKernel, PlanarHingeKernel, SpatialHingeKernel, TrussKernel,
+    TwoNodeSpatial,
 };
 use crate::section::{positive, Material, SectionShape};
 use crate::superelement::LinearSuperelement;
@@ -738,6 +739,38 @@ impl Element {
                 let aa: [f64; $nx] = std::array::from_fn(|i| a[i]);
                 let ba: [f64; $nx] = std::array::from_fn(|i| b[i]);
                 let d = second_directional::<_, $nx, $ne>($k, &xa, &aa, &ba);
+                out[..$ne].copy_from_slice(&d);
+            }};
+        }
+        self.dispatch_def(x, None, |k| match k {
+            KRef::Planar(k) => go!(k, 6, 3),
+            KRef::Truss2(k) => go!(k, 4, 1),
+            KRef::Hinge2(k) => go!(k, 2, 1),
+            KRef::TwoNode(k) => go!(k, 14, 6),
+            KRef::Truss3(k) => go!(k, 6, 1),
+            KRef::Hinge3(k) => go!(k, 8, 3),
+            KRef::Norm(k) => go!(k, 4, 1),
+        });
+        let k = self.mode_count();
+        if k > 0 {
+            out[6..6 + k].fill(0.0);
+        }
+    }
+
+    /// The directional third derivative D,xxx\[a, b, c\] (length n_ε), needed by
+    /// the linearization of the convective terms (thesis (E.5f)).
+    pub fn deformation_third_derivative(
+        &self,
+        x: &[f64],
+        a: &[f64],
+        b: &[f64],
+        c: &[f64],
+        out: &mut [f64],
+    ) {
+        macro_rules! go {
+            ($k:expr, $nx:literal, $ne:literal) => {{
+                let f = |v: &[f64]| -> [f64; $nx] { std::array::from_fn(|i| v[i]) };
+                let d = third_directional::<_, $nx, $ne>($k, &f(x), &f(a), &f(b), &f(c));
                 out[..$ne].copy_from_slice(&d);
             }};
         }

@@ -31,6 +31,28 @@ pub(crate) fn second_directional<K: DefKernel<NX, NE>, const NX: usize, const NE
     k.eval(&xd).map(|v| v.d2())
 }
 
+/// The directional third derivative D,xxx\[a, b, c\] (for the linearization of
+/// convective terms, (E.5f)).
+pub(crate) fn third_directional<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
+    k: &K,
+    x: &[f64; NX],
+    a: &[f64; NX],
+    b: &[f64; NX],
+    c: &[f64; NX],
+) -> [f64; NE] {
+    type D3 = Dual<Dual<Dual<f64, 1>, 1>, 1>;
+    let xd: [D3; NX] = std::array::from_fn(|i| {
+        // x + ε1 a + ε2 b + ε3 c
+        let inner = |v0: f64, v1: f64| Dual::new(v0, [v1]);
+        let mid = |r: Dual<f64, 1>, e: Dual<f64, 1>| Dual::new(r, [e]);
+        D3::new(
+            mid(inner(x[i], c[i]), inner(b[i], 0.0)),
+            [mid(inner(a[i], 0.0), inner(0.0, 0.0))],
+        )
+    });
+    k.eval(&xd).map(|v| v.eps[0].eps[0].eps[0])
+}
+
 /// The weighted Hessian Σᵢ wᵢ Dᵢ,xx (`NX × NX`).
 pub(crate) fn weighted_hessian<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
     k: &K,

@@ -290,3 +290,30 @@ fn gravity_force_derivative_matches_central_differences_and_equals_potential_gra
         assert!(err < TOL, "{name}: ∂f_g/∂x {err:e}");
     }
 }
+
+#[test]
+fn third_directional_derivative_matches_differences_of_the_second() {
+    let mut r = rng(18);
+    let h = 1e-5;
+    for (name, e) in catalogue(&mut r) {
+        if e.n_eps() == 0 {
+            continue;
+        }
+        let x = random_x(&mut r, &e);
+        let a = random_x(&mut r, &e);
+        let b = random_xd(&mut r, &e, &x);
+        let c = random_xd(&mut r, &e, &x);
+        let ne = e.n_eps();
+        let mut d3 = vec![0.0; ne];
+        e.deformation_third_derivative(&x, &a, &b, &c, &mut d3);
+        let d2 = |x: &[f64]| {
+            let mut o = vec![0.0; ne];
+            e.deformation_second_derivative(x, &b, &c, &mut o);
+            o
+        };
+        let (p, m) = (d2(&shifted(&x, &a, h)), d2(&shifted(&x, &a, -h)));
+        let fd: Vec<f64> = (0..ne).map(|k| (p[k] - m[k]) / (2.0 * h)).collect();
+        let err = rel_err(&d3, &fd);
+        assert!(err < TOL, "{name}: D,xxx[a,b,c] relative error {err:e}");
+    }
+}

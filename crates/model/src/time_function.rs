@@ -56,7 +56,7 @@ pub enum TimeFunction {
         moves: Vec<(f64, f64, f64)>,
     },
     /// Piecewise polynomials in absolute time as in thesis (5.25): on
-    /// [breaks[i], breaks[i+1]) the value is Σ_k coeffs[i][k] tᵏ; before the first
+    /// `[breaks[i], breaks[i+1])` the value is `Σ_k coeffs[i][k] tᵏ`; before the first
     /// break the first piece, after the last break the constant `after`.
     PiecewisePolynomial {
         /// Break points (n + 1 for n pieces), increasing.

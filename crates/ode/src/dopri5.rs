@@ -105,7 +105,7 @@ const E: [f64; 7] = [
     -1.0 / 40.0,
 ];
 
-/// Continuous extension: `b_j(s) = Σ_m BI[j][m]·s^(m+1)`.
+/// Continuous extension: `b_j(s) = Σ_m BI[j](m)·s^(m+1)`.
 const BI: [[f64; 4]; 7] = [
     [1.0, -183.0 / 64.0, 37.0 / 12.0, -145.0 / 128.0],
     [0.0, 0.0, 0.0, 0.0],

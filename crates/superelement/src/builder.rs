@@ -32,11 +32,11 @@ use std::time::Instant;
 /// at `points[i]` moves by `displacements[i]`. Nodes are matched by position.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct InterfacePattern {
-    /// Node positions [m].
+    /// Node positions (m).
     pub points: Vec<[f64; 3]>,
     /// Their displacements.
     pub displacements: Vec<[f64; 3]>,
-    /// Matching tolerance [m]; default 1e-6 × the model's bounding-box diagonal.
+    /// Matching tolerance (m); default 1e-6 × the model's bounding-box diagonal.
     #[serde(default)]
     pub tolerance: Option<f64>,
 }
@@ -65,11 +65,11 @@ pub struct InterfaceMode {
 pub struct PointMass {
     /// A name for messages.
     pub name: String,
-    /// Mass [kg].
+    /// Mass (kg).
     pub mass: f64,
-    /// Position of its centre of mass [m] (global).
+    /// Position of its centre of mass (m) (global).
     pub position: [f64; 3],
-    /// Inertia tensor about its centre of mass, global axes [kg m²].
+    /// Inertia tensor about its centre of mass, global axes (kg m²).
     #[serde(default)]
     pub inertia: Option<[[f64; 3]; 3]>,
     /// The nodes it is attached to.
@@ -83,9 +83,9 @@ fn default_density_range() -> Option<[f64; 2]> {
 /// What to build.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BuildSettings {
-    /// Boundary node p [m] (global); the element frame's origin.
+    /// Boundary node p (m) (global); the element frame's origin.
     pub p: [f64; 3],
-    /// Boundary node q [m]; the element x axis points from p to q.
+    /// Boundary node q (m); the element x axis points from p to q.
     pub q: [f64; 3],
     /// A vector fixing the element y axis (its component normal to x); default
     /// global y, or global z when x is nearly parallel to y.
@@ -110,7 +110,7 @@ pub struct BuildSettings {
     /// Point masses and rigid links.
     #[serde(default)]
     pub point_masses: Vec<PointMass>,
-    /// Plausible density range [kg/m³] for the units check (total FE mass over
+    /// Plausible density range (kg/m³) for the units check (total FE mass over
     /// the mesh volume, when the volume is known); `None` disables it.
     #[serde(default = "default_density_range")]
     pub density_range: Option<[f64; 2]>,
@@ -151,11 +151,11 @@ pub struct BuildReport {
     pub interface_nodes: [usize; 2],
     /// Stored entries of the Cholesky factor of the interior stiffness.
     pub factor_nnz: usize,
-    /// Fixed-interface normal-mode frequencies [Hz].
+    /// Fixed-interface normal-mode frequencies (Hz).
     pub normal_frequencies_hz: Vec<f64>,
-    /// Total FE mass (without point masses) [kg].
+    /// Total FE mass (without point masses) (kg).
     pub fe_mass: f64,
-    /// Wall time of the phases [s]: (name, seconds).
+    /// Wall time of the phases (s): (name, seconds).
     pub timings: Vec<(String, f64)>,
 }
 
@@ -186,7 +186,7 @@ impl BuildResult {
         std::array::from_fn(|d| e[d].map_or(0.0, |r| self.shapes[(r, col)]))
     }
 
-    /// Eigenfrequencies [Hz] of the superelement with the coordinates `keep`
+    /// Eigenfrequencies (Hz) of the superelement with the coordinates `keep`
     /// of (µ̄, η̄) free and all others fixed.
     pub fn frequencies(&self, keep: &[usize]) -> Result<Vec<f64>, Error> {
         let m = self.data.m_bar_matrix();
@@ -197,7 +197,7 @@ impl BuildResult {
         Ok(to_hz(&lam))
     }
 
-    /// Clamped-free eigenfrequencies [Hz]: µ̄p fixed, interface modes fixed
+    /// Clamped-free eigenfrequencies (Hz): µ̄p fixed, interface modes fixed
     /// (rigid interfaces), µ̄q and the normal modes free.
     pub fn clamped_free_frequencies(&self) -> Result<Vec<f64>, Error> {
         let (kp, kq, kf) = self.data.mode_counts();
@@ -211,11 +211,11 @@ impl BuildResult {
 /// inertia tensor about it, in the element frame with origin at p.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RigidBodyProperties {
-    /// Mass [kg].
+    /// Mass (kg).
     pub mass: f64,
-    /// Centre of mass [m], element frame, from p.
+    /// Centre of mass (m), element frame, from p.
     pub com: [f64; 3],
-    /// Inertia tensor about the centre of mass [kg m²], element frame.
+    /// Inertia tensor about the centre of mass (kg m²), element frame.
     pub inertia: [[f64; 3]; 3],
 }
 
@@ -1296,7 +1296,7 @@ fn normal_modes(ctx: &Ctx<'_>, prob: &Problem, nev: usize) -> Result<(Vec<f64>, 
     lowest_eigenpairs(&prob.llt, apply_m, nev)
 }
 
-/// Eigenfrequencies [Hz] of the full FE model with interface p clamped and
+/// Eigenfrequencies (Hz) of the full FE model with interface p clamped and
 /// interface q rigid and free (the reference a clamped-free superelement is
 /// compared with), the `n` lowest, by shift-invert on a sparse factorization.
 pub fn full_model_clamped_free_frequencies(
@@ -1353,11 +1353,11 @@ pub fn fixed_interface_eigenvalues_sparse(
 /// A rigid motion: translation plus a small rotation about a point.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RigidMotion {
-    /// Translation [m].
+    /// Translation (m).
     pub translation: [f64; 3],
-    /// Rotation vector [rad].
+    /// Rotation vector (rad).
     pub rotation: [f64; 3],
-    /// Point the rotation is about [m].
+    /// Point the rotation is about (m).
     pub about: [f64; 3],
 }
 

@@ -398,7 +398,7 @@ pub fn dense_generalized_eigen(
     Ok((lam, phi))
 }
 
-/// Frequencies [Hz] from eigenvalues ω².
+/// Frequencies (Hz) from eigenvalues ω².
 pub fn to_hz(lam: &[f64]) -> Vec<f64> {
     lam.iter()
         .map(|&l| l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))

@@ -87,7 +87,7 @@ pub struct FeModel {
     dofs: DofMap,
     k: SparseColMat<usize, f64>,
     m: SparseColMat<usize, f64>,
-    /// The mesh volume [m³], if known (used for the density plausibility check).
+    /// The mesh volume (m³), if known (used for the density plausibility check).
     pub volume: Option<f64>,
 }
 
@@ -172,7 +172,7 @@ impl FeModel {
     pub fn node_ids(&self) -> &[u64] {
         &self.node_ids
     }
-    /// Node coordinates [m].
+    /// Node coordinates (m).
     pub fn coords(&self) -> &[[f64; 3]] {
         &self.coords
     }
@@ -374,27 +374,27 @@ pub enum NodeSelection {
     Ids(Vec<u64>),
     /// Nodes within `tolerance` of the plane through `point` with normal `normal`.
     NearPlane {
-        /// A point of the plane [m].
+        /// A point of the plane (m).
         point: [f64; 3],
         /// Its normal (need not be unit).
         normal: [f64; 3],
-        /// Distance tolerance [m].
+        /// Distance tolerance (m).
         tolerance: f64,
     },
     /// Nodes inside an axis-aligned box (bounds inclusive).
     InBox {
-        /// Lower corner [m].
+        /// Lower corner (m).
         min: [f64; 3],
-        /// Upper corner [m].
+        /// Upper corner (m).
         max: [f64; 3],
     },
     /// Nodes within `radius` of the segment from `a` to `b`.
     NearSegment {
-        /// Start [m].
+        /// Start (m).
         a: [f64; 3],
-        /// End [m].
+        /// End (m).
         b: [f64; 3],
-        /// Radius [m].
+        /// Radius (m).
         radius: f64,
     },
     /// Nodes in any of the selections.

@@ -164,9 +164,9 @@ type ElementMatrices = (Vec<f64>, Vec<f64>, f64);
 /// An axis-aligned box of one material.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Block {
-    /// Lower corner [m].
+    /// Lower corner (m).
     pub min: [f64; 3],
-    /// Upper corner [m].
+    /// Upper corner (m).
     pub max: [f64; 3],
     /// Index into the mesh's materials.
     pub material: usize,
@@ -175,7 +175,7 @@ pub struct Block {
 /// A 20-node hexahedral mesh.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
-    /// Node coordinates [m]; node labels are index + 1.
+    /// Node coordinates (m); node labels are index + 1.
     pub coords: Vec<[f64; 3]>,
     /// Element connectivity (node indices) in [`HEX20_LOCAL`] order.
     pub elements: Vec<[usize; 20]>,
@@ -282,7 +282,7 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// A structured block of n[0] × n[1] × n[2] elements whose nodes are the
+    /// A structured block of `n[0] × n[1] × n[2]` elements whose nodes are the
     /// image of the unit cube's quadratic grid under `map` (e.g. a cylinder).
     pub fn mapped(
         n: [usize; 3],

@@ -51,7 +51,7 @@ pub enum ModelSource {
         /// DOF file (`node.dir` per equation); default 3 DOFs per node.
         #[serde(default)]
         dofs: Option<String>,
-        /// Mesh volume [m³] for the units check, if known.
+        /// Mesh volume (m³) for the units check, if known.
         #[serde(default)]
         volume: Option<f64>,
     },
