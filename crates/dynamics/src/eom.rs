@@ -37,6 +37,8 @@ pub struct Dynamics {
     pub(crate) rhs: Vec<f64>,
     /// Factor on loads and gravity (load stepping in statics).
     pub(crate) load_factor: f64,
+    /// A persistent scale of the loads (not gravity), e.g. for load sweeps.
+    pub(crate) load_scale: f64,
     evaluations: u64,
 }
 
@@ -53,6 +55,7 @@ impl Dynamics {
             mq: Mat::zeros(n_q, n_q),
             rhs: vec![0.0; n_q],
             load_factor: 1.0,
+            load_scale: 1.0,
             evaluations: 0,
             mech,
         }
@@ -112,7 +115,7 @@ impl Dynamics {
         let x = self.kin.x();
         let eps = self.kin.eps();
         self.f.fill(0.0);
-        let lf = self.load_factor;
+        let lf = self.load_factor * self.load_scale;
         for l in &mech.loads {
             match l {
                 Load::Force { index, f, function } => {
@@ -350,6 +353,12 @@ impl Dynamics {
             g[r] = s;
         }
         Ok(())
+    }
+
+    /// Scales the nodal loads (not gravity) by `s` in every later evaluation,
+    /// statics and linearization: the parameter of a load sweep.
+    pub fn set_load_scale(&mut self, s: f64) {
+        self.load_scale = s;
     }
 
     /// The mass matrix Mq of the last evaluation.

@@ -143,7 +143,7 @@ impl Dynamics {
                 function,
             } = ld
             {
-                let s = self.load_factor * function.value(t);
+                let s = self.load_factor * self.load_scale * function.value(t);
                 let mut d = vec![0.0; 16];
                 for b in 0..4 {
                     let mut e = [0.0; 4];

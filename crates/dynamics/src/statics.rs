@@ -150,7 +150,7 @@ impl Dynamics {
         for ld in &mech.loads {
             if let Load::SpatialMoment { index, m, function } = ld {
                 // f_λ = 2 Λ(λ)ᵀ m s is linear in λ: ∂f/∂λ = 2 s ∂(Λᵀm)/∂λ
-                let s = self.load_factor * function.value(t);
+                let s = self.load_factor * self.load_scale * function.value(t);
                 let mut d = vec![0.0; 16];
                 for b in 0..4 {
                     let mut e = [0.0; 4];

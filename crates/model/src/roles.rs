@@ -378,6 +378,32 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
         }
         v.into_iter().filter(|i| xr[*i] == R::Free).collect()
     };
+    for s in &scene.dofs_first {
+        for c in resolve(mech, s, "dofs_first")? {
+            let (ok, name) = match c {
+                Coordinate::Node(i) => (xr[i] == R::Free, mech.x_names[i].clone()),
+                Coordinate::Def(j) => (er[j] == R::Free, mech.eps_names[j].clone()),
+            };
+            if !ok {
+                return Err(ModelError::Role {
+                    name,
+                    message: "is fixed, rigid or prescribed and cannot be a degree of freedom"
+                        .into(),
+                });
+            }
+            let g = match c {
+                Coordinate::Node(i) => project_x(i),
+                Coordinate::Def(j) => project_def(j),
+            };
+            if !accept(g, &mut basis) {
+                return Err(ModelError::OverConstrained {
+                    redundant: vec![format!("{name} (as a degree of freedom)")],
+                });
+            }
+            chosen.push(c);
+        }
+    }
+    let already: std::collections::HashSet<Coordinate> = chosen.iter().copied().collect();
     match &scene.dofs {
         DofChoice::Deformations | DofChoice::NodalCoordinates => {
             if scene.dofs == DofChoice::Deformations {
@@ -401,7 +427,7 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
                 if chosen.len() == d {
                     break;
                 }
-                if accept(project_x(i), &mut basis) {
+                if !already.contains(&Coordinate::Node(i)) && accept(project_x(i), &mut basis) {
                     chosen.push(Coordinate::Node(i));
                 }
             }

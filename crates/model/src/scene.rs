@@ -346,6 +346,10 @@ pub struct Scene {
     /// The choice of degrees of freedom.
     #[serde(default)]
     pub dofs: DofChoice,
+    /// Coordinates or deformations that must be degrees of freedom, taken
+    /// before the automatic choice (e.g. a coordinate a sweep holds).
+    #[serde(default)]
+    pub dofs_first: Vec<Select>,
     /// Nodal loads.
     #[serde(default)]
     pub loads: Vec<LoadSpec>,

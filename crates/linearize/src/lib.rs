@@ -1,0 +1,80 @@
+//! Analyses of the linearized equations of flexible mechanisms (thesis
+//! Appendix E, (4.2)): undamped eigenfrequencies and modes, damped and
+//! gyroscopic modes with damping ratios, buckling load factors, mode shapes in
+//! nodal coordinates, the MAC matrix and MAC mode tracking, and sweeps of the
+//! eigenfrequencies along a load, a coordinate or a path, in parallel.
+//!
+//! ```
+//! use flexmb_model::Scene;
+//! use flexmb_dynamics::Dynamics;
+//! use std::sync::Arc;
+//! // a mass on a massless cantilever: one bending mode, ω² = 3EI/(m L³)
+//! let scene = Scene::from_ron_str(r#"(
+//!     dimension: Planar,
+//!     materials: { "s": (e: 2.0e11, rho: 1.0) },
+//!     sections: { "b": User((area: 1e-4, iy: 1e-9, iz: 1e-9, j: 1e-9, ky: inf, kz: inf)) },
+//!     nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [1.0, 0.0]) ],
+//!     elements: [
+//!         (id: "beam", type: Beam((nodes: ("A", "B"), material: "s", section: "b", mass: false))),
+//!         (id: "m", type: PointMass(node: "B", mass: 2.0, inertia: Some(1e-6))),
+//!     ],
+//!     fixed: [ Node("A") ],
+//!     rigid: [ Def("beam", "elongation") ],
+//! )"#).unwrap();
+//! let mut dy = Dynamics::new(Arc::new(scene.build(None).unwrap()));
+//! let q0 = dy.mechanism().q0();
+//! let lin = dy.linearize_at_rest(0.0, &q0).unwrap();
+//! let modes = flexmb_linearize::undamped_modes(&lin, 1).unwrap();
+//! let expect = (3.0 * 2.0e11 * 1e-9 / 2.0f64).sqrt() / (2.0 * std::f64::consts::PI);
+//! assert!((modes.frequencies_hz()[0] / expect - 1.0).abs() < 1e-3);
+//! ```
+#![warn(missing_docs)]
+
+mod mac;
+mod modes;
+mod sweep;
+
+pub use mac::{mac, mac_matrix, track_modes, Tracking};
+pub use modes::{
+    asymmetry, buckling_factors, damped_modes, generalized_symmetric, undamped_modes, DampedMode,
+    Modes,
+};
+pub use sweep::{sweep, SweepOptions, SweepParameter, SweepPoint};
+
+use faer::Mat;
+
+/// Mode shapes in nodal coordinates: F,q V (n_x × k), at the kinematic state
+/// of the last evaluation of `dy`.
+pub fn nodal_mode_shapes(dy: &flexmb_dynamics::Dynamics, vectors: &Mat<f64>) -> Mat<f64> {
+    let n_q = vectors.nrows();
+    let f = dy.kinematics().f_xi().subcols(0, n_q);
+    f * vectors
+}
+
+/// Failures of the analyses.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum LinearizeError {
+    /// Inconsistent matrix sizes.
+    #[error("dimension mismatch: {0}")]
+    Dimension(String),
+    /// A non-finite entry.
+    #[error("non-finite entries in the {0}")]
+    NonFinite(&'static str),
+    /// The mass matrix is not positive definite.
+    #[error("the mass matrix is not positive definite: some degree of freedom has no inertia")]
+    MassNotPositive,
+    /// The structural stiffness is not positive definite (buckling needs it).
+    #[error("the structural stiffness is not positive definite: the structure has a mechanism (unrestrained motion)")]
+    StiffnessNotPositive,
+    /// An eigen solver did not converge.
+    #[error("the eigenvalue solver did not converge")]
+    NoConvergence,
+    /// The equilibrium of a sweep configuration failed.
+    #[error("sweep configuration s = {s}: {message}")]
+    Equilibrium {
+        /// Sweep parameter.
+        s: f64,
+        /// Cause.
+        message: String,
+    },
+}

@@ -1,0 +1,143 @@
+//! Eigenfrequencies along the range of motion: at each of n configurations the
+//! static equilibrium (a continuation from the previous one), then the rest
+//! linearization (E.6) and the undamped modes; the linearizations and eigen
+//! analyses run in parallel (rayon), each worker with its own dynamics.
+
+use crate::{undamped_modes, LinearizeError, Modes};
+use faer::Mat;
+use flexmb_dynamics::{Dynamics, StaticOptions};
+use flexmb_model::Mechanism;
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// What varies along the sweep.
+pub enum SweepParameter {
+    /// The nodal loads are scaled by s (gravity stays).
+    LoadScale,
+    /// The degree of freedom with this index is held at s (its reaction is the
+    /// actuation force).
+    Dof(usize),
+    /// Several degrees of freedom follow a path P(s) (thesis (4.1)).
+    Path {
+        /// The held DOF indices.
+        dofs: Vec<usize>,
+        /// Their values as functions of s.
+        path: Box<dyn Fn(f64) -> Vec<f64> + Sync + Send>,
+    },
+}
+
+/// Settings of a sweep.
+pub struct SweepOptions {
+    /// Sweep parameter values.
+    pub values: Vec<f64>,
+    /// Number of modes per configuration.
+    pub modes: usize,
+    /// Time at which loads are evaluated.
+    pub t: f64,
+    /// Keep the mode shapes (in q).
+    pub keep_vectors: bool,
+}
+
+/// One configuration of a sweep.
+#[derive(Clone, Debug)]
+pub struct SweepPoint {
+    /// The sweep parameter.
+    pub s: f64,
+    /// The equilibrium DOFs.
+    pub q: Vec<f64>,
+    /// Undamped eigenfrequencies (Hz).
+    pub frequencies_hz: Vec<f64>,
+    /// Mode shapes (if kept).
+    pub modes: Option<Mat<f64>>,
+    /// Mass matrix (if the shapes are kept: for MAC with mass weighting).
+    pub mass: Option<Mat<f64>>,
+}
+
+/// Runs a sweep. `progress(done, total)` is called as configurations finish.
+pub fn sweep(
+    mech: &Arc<Mechanism>,
+    param: &SweepParameter,
+    opts: &SweepOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<SweepPoint>, LinearizeError> {
+    let n = opts.values.len();
+    let total = 2 * n;
+    let mut dy = Dynamics::new(mech.clone());
+    let mut q = mech.q0();
+    let mut qs = Vec::with_capacity(n);
+    // phase 1: equilibria by continuation
+    for (i, &s) in opts.values.iter().enumerate() {
+        let mut so = StaticOptions::default();
+        match param {
+            SweepParameter::LoadScale => dy.set_load_scale(s),
+            SweepParameter::Dof(k) => so.held = vec![(*k, s)],
+            SweepParameter::Path { dofs, path } => {
+                let v = path(s);
+                so.held = dofs.iter().copied().zip(v).collect();
+            }
+        }
+        let sol =
+            dy.static_equilibrium(opts.t, &q, &so)
+                .map_err(|e| LinearizeError::Equilibrium {
+                    s,
+                    message: e.to_string(),
+                })?;
+        q = sol.q;
+        qs.push(q.clone());
+        progress(i + 1, total);
+    }
+    // phase 2: linearization and eigen analysis in parallel
+    let done = std::sync::atomic::AtomicUsize::new(n);
+    let scale: Vec<f64> = opts
+        .values
+        .iter()
+        .map(|s| {
+            if matches!(param, SweepParameter::LoadScale) {
+                *s
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let chunk = n.div_ceil(rayon::current_num_threads().max(1)).max(1);
+    let results: Vec<Result<Vec<(Modes, Mat<f64>)>, LinearizeError>> = qs
+        .par_chunks(chunk)
+        .enumerate()
+        .map(|(c, block)| {
+            let mut dy = Dynamics::new(mech.clone());
+            block
+                .iter()
+                .enumerate()
+                .map(|(j, q)| {
+                    let i = c * chunk + j;
+                    dy.set_load_scale(scale[i]);
+                    let lin = dy.linearize_at_rest(opts.t, q).map_err(|e| {
+                        LinearizeError::Equilibrium {
+                            s: opts.values[i],
+                            message: e.to_string(),
+                        }
+                    })?;
+                    let modes = undamped_modes(&lin, opts.modes)?;
+                    let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    progress(d, total);
+                    Ok((modes, lin.m))
+                })
+                .collect()
+        })
+        .collect();
+    let mut out = Vec::with_capacity(n);
+    let mut i = 0;
+    for r in results {
+        for (modes, m) in r? {
+            out.push(SweepPoint {
+                s: opts.values[i],
+                q: qs[i].clone(),
+                frequencies_hz: modes.frequencies_hz(),
+                modes: opts.keep_vectors.then(|| modes.vectors.clone()),
+                mass: opts.keep_vectors.then_some(m),
+            });
+            i += 1;
+        }
+    }
+    Ok(out)
+}
