@@ -75,6 +75,46 @@ enum Command {
         #[arg(long, default_value = "results/simulate")]
         out: PathBuf,
     },
+    /// Eigenfrequencies at the reference configuration or at the static equilibrium.
+    Eig {
+        /// Scene file (RON).
+        scene: PathBuf,
+        /// Number of modes.
+        #[arg(long, default_value_t = 10)]
+        modes: usize,
+        /// Linearize at the static equilibrium under the scene's loads and gravity.
+        #[arg(long)]
+        static_first: bool,
+        /// Also report buckling load factors of the current loads.
+        #[arg(long)]
+        buckling: bool,
+    },
+    /// Eigenfrequencies along the range of motion: over a load scale or a
+    /// held coordinate, n equilibria, eigen analyses in parallel.
+    Sweep {
+        /// Scene file (RON).
+        scene: PathBuf,
+        /// `load` (scale the scene's loads) or a coordinate/deformation name
+        /// such as `S.x` or `flexure1.3.bending_z_p` (`flexmb info` lists them);
+        /// a coordinate is swept as its change from the reference configuration.
+        #[arg(long)]
+        over: String,
+        /// First value of the sweep parameter.
+        #[arg(long)]
+        from: f64,
+        /// Last value.
+        #[arg(long)]
+        to: f64,
+        /// Number of configurations.
+        #[arg(long, default_value_t = 50)]
+        n: usize,
+        /// Modes per configuration.
+        #[arg(long, default_value_t = 6)]
+        modes: usize,
+        /// Output directory.
+        #[arg(long, default_value = "results/sweep")]
+        out: PathBuf,
+    },
     /// Build a linear superelement from FE matrices (see crates/superelement/README.md).
     BuildSuperelement {
         /// Specification file (RON).
@@ -135,6 +175,21 @@ fn main() -> ExitCode {
             &out,
             &interrupted,
         ),
+        Command::Eig {
+            scene,
+            modes,
+            static_first,
+            buckling,
+        } => eig(&scene, modes, static_first, buckling),
+        Command::Sweep {
+            scene,
+            over,
+            from,
+            to,
+            n,
+            modes,
+            out,
+        } => sweep(&scene, &over, from, to, n, modes, &out),
         Command::BuildSuperelement { spec } => build_superelement(&spec),
     };
     match result {
@@ -331,6 +386,209 @@ fn simulate(
     if traj.stopped {
         return Err(Failure::Interrupted);
     }
+    Ok(())
+}
+
+fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), Failure> {
+    let (_, mech) = load(path)?;
+    let mut dy = Dynamics::new(mech.clone());
+    let mut q = mech.q0();
+    if static_first {
+        q = dy
+            .static_equilibrium(0.0, &q, &StaticOptions::default())
+            .map_err(|e| Failure::Compute(e.to_string()))?
+            .q;
+    }
+    let lin = dy
+        .linearize_at_rest(0.0, &q)
+        .map_err(|e| Failure::Compute(e.to_string()))?;
+    let modes =
+        flexmb_linearize::undamped_modes(&lin, k).map_err(|e| Failure::Compute(e.to_string()))?;
+    println!("{}", mech.summary());
+    println!(
+        "undamped eigenfrequencies (Hz){}:",
+        if static_first {
+            " at the static equilibrium"
+        } else {
+            " at the reference configuration"
+        }
+    );
+    for (i, f) in modes.frequencies_hz().iter().enumerate() {
+        println!("  {:>3}  {f:>14.6}", i + 1);
+    }
+    let has_damping = lin.d.col_iter().any(|c| c.iter().any(|v| *v != 0.0));
+    if has_damping {
+        let d =
+            flexmb_linearize::damped_modes(&lin).map_err(|e| Failure::Compute(e.to_string()))?;
+        println!("damped modes (frequency Hz, damping ratio):");
+        for (i, m) in d.iter().take(k).enumerate() {
+            println!(
+                "  {:>3}  {:>14.6}  {:>8.4}",
+                i + 1,
+                m.frequency_hz,
+                m.damping_ratio
+            );
+        }
+    }
+    if buckling {
+        match flexmb_linearize::buckling_factors(&lin, 3.min(k)) {
+            Ok(mu) => println!("buckling load factors: {mu:?}"),
+            Err(e) => println!("buckling: {e}"),
+        }
+    }
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn sweep(
+    path: &Path,
+    over: &str,
+    from: f64,
+    to: f64,
+    n: usize,
+    k: usize,
+    out: &Path,
+) -> Result<(), Failure> {
+    if n < 1 || !from.is_finite() || !to.is_finite() {
+        return Err(Failure::Input(
+            "--n must be ≥ 1 and --from/--to finite".into(),
+        ));
+    }
+    let mut scene = Scene::load(path).map_err(|e| Failure::Input(e.to_string()))?;
+    let values: Vec<f64> = (0..n)
+        .map(|i| {
+            if n == 1 {
+                from
+            } else {
+                from + (to - from) * i as f64 / (n - 1) as f64
+            }
+        })
+        .collect();
+    let (mech, param) = if over == "load" {
+        let mech = scene
+            .build(path.parent())
+            .map_err(|e| Failure::Input(e.to_string()))?;
+        (Arc::new(mech), flexmb_linearize::SweepParameter::LoadScale)
+    } else {
+        // make the coordinate a degree of freedom, then hold it
+        let probe = scene
+            .build(path.parent())
+            .map_err(|e| Failure::Input(e.to_string()))?;
+        let select = if let Some(i) = probe.x_names.iter().position(|x| x == over) {
+            let _ = i;
+            let (node, comp) = over
+                .rsplit_once('.')
+                .ok_or_else(|| Failure::Input(format!("bad coordinate '{over}'")))?;
+            let c = match comp {
+                "x" => flexmb_model::Component::X,
+                "y" => flexmb_model::Component::Y,
+                "z" => flexmb_model::Component::Z,
+                "angle" => flexmb_model::Component::Angle,
+                l if l.starts_with('l') => flexmb_model::Component::Lambda(
+                    l[1..]
+                        .parse()
+                        .map_err(|_| Failure::Input(format!("bad coordinate '{over}'")))?,
+                ),
+                _ => return Err(Failure::Input(format!("bad coordinate '{over}'"))),
+            };
+            flexmb_model::Select::Coord(node.to_string(), c)
+        } else if let Some(j) = probe.eps_names.iter().position(|x| x == over) {
+            let e = probe
+                .elements
+                .iter()
+                .find(|e| e.eps_offset <= j && j < e.eps_offset + e.element.n_eps())
+                .expect("owner");
+            flexmb_model::Select::Def(
+                e.id.clone(),
+                e.element.deformation_names()[j - e.eps_offset].clone(),
+            )
+        } else {
+            return Err(Failure::Input(format!("'{over}' is neither `load` nor a coordinate or deformation of the scene (see `flexmb info`)")));
+        };
+        scene.dofs_first.insert(0, select);
+        let mech = Arc::new(
+            scene
+                .build(path.parent())
+                .map_err(|e| Failure::Input(e.to_string()))?,
+        );
+        let k = mech
+            .dofs
+            .iter()
+            .position(|c| mech.coordinate_name(*c) == over)
+            .expect("first DOF");
+        // the sweep parameter is the change from the reference configuration
+        let q_ref = mech.q0()[k];
+        let param = flexmb_linearize::SweepParameter::Path {
+            dofs: vec![k],
+            path: Box::new(move |s| vec![q_ref + s]),
+        };
+        (mech, param)
+    };
+    println!("{}", mech.summary());
+    let pb = ProgressBar::new(2 * n as u64);
+    pb.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} {elapsed} elapsed, ETA {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    pb.set_message("equilibria, then eigen analyses");
+    let start = std::time::Instant::now();
+    let opts = flexmb_linearize::SweepOptions {
+        values,
+        modes: k,
+        t: 0.0,
+        keep_vectors: false,
+    };
+    let pts = flexmb_linearize::sweep(&mech, &param, &opts, &|d, _| pb.set_position(d as u64))
+        .map_err(|e| Failure::Compute(e.to_string()))?;
+    pb.finish_and_clear();
+    let wall = start.elapsed().as_secs_f64();
+    println!("{n} configurations, {k} modes each, in {wall:.2} s");
+    std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
+    let mut header = vec![if over == "load" {
+        "load_scale".to_string()
+    } else {
+        format!("{over} change")
+    }];
+    header.extend((1..=k).map(|i| format!("f{i}_hz")));
+    let rows: Vec<Vec<f64>> = pts
+        .iter()
+        .map(|p| {
+            std::iter::once(p.s)
+                .chain(p.frequencies_hz.iter().copied())
+                .collect()
+        })
+        .collect();
+    let csv = out.join("eigenfrequencies.csv");
+    write_csv(
+        &csv,
+        &[
+            format!(
+                "flexmb sweep {} --over {over} --from {from} --to {to} --n {n} --modes {k}",
+                path.display()
+            ),
+            "undamped eigenfrequencies at static equilibria (rest linearization, thesis (E.6))"
+                .into(),
+        ],
+        &header,
+        &rows,
+    )
+    .map_err(|e| io_err(e, &csv))?;
+    let mut plot = Plot::new(
+        &format!("{}: eigenfrequencies", mech.name),
+        over,
+        "frequency (Hz)",
+    );
+    let s: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+    for i in 0..k {
+        let f: Vec<f64> = rows
+            .iter()
+            .map(|r| r.get(i + 1).copied().unwrap_or(f64::NAN))
+            .collect();
+        plot.push(Series::line(&format!("ω{}", i + 1), &s, &f));
+    }
+    let svg = out.join("eigenfrequencies.svg");
+    plot.save(&svg).map_err(|e| io_err(e, &svg))?;
+    println!("wrote {} and {}", csv.display(), svg.display());
     Ok(())
 }
 

@@ -22,6 +22,11 @@ pub struct StaticOptions {
     pub held: Vec<(usize, f64)>,
     /// Smallest load increment before giving up.
     pub min_increment: f64,
+    /// Ramp the loads and gravity with the continuation parameter (true), or
+    /// apply them fully from the start (false: a continuation from an
+    /// equilibrium that already carries them, e.g. the previous sweep point).
+    /// Held values are always ramped from their values in `q0`.
+    pub ramp_loads: bool,
 }
 
 impl Default for StaticOptions {
@@ -32,6 +37,7 @@ impl Default for StaticOptions {
             tol: 1e-11,
             held: vec![],
             min_increment: 1e-4,
+            ramp_loads: true,
         }
     }
 }
@@ -79,35 +85,62 @@ impl Dynamics {
         let n_q = mech.n_dof();
         let e = self.kin.e_xi();
         let f = self.kin.f_xi();
-        let mut k = Mat::<f64>::zeros(n_q, n_q);
+        // SE = blockdiag(S_e) E (rigid and prescribed rows are zero), K = Eᵀ SE
+        let n_e = mech.n_eps();
+        let mut se = Mat::<f64>::zeros(n_e, n_q);
+        let mut ef = Mat::<f64>::zeros(n_e, n_q);
+        let mut gains = vec![0.0; n_e];
+        for c in &mech.controllers {
+            if let Coordinate::Def(j) = c.on {
+                gains[j] += c.kp;
+            }
+        }
         for el in &mech.elements {
             let ne = el.element.n_eps();
-            if ne == 0 || el.element.stiffness().iter().all(|v| *v == 0.0) {
+            if ne == 0 {
                 continue;
             }
+            let s = el.element.stiffness();
             let o = el.eps_offset;
-            let ee = Mat::from_fn(ne, n_q, |a, c| {
-                if matches!(
+            let active = |a: usize| {
+                !matches!(
                     mech.e_roles[o + a],
                     flexmb_model::ERole::Rigid | flexmb_model::ERole::Input(_)
-                ) {
-                    0.0
-                } else {
-                    e[(o + a, c)]
-                }
-            });
-            let s = Mat::from_fn(ne, ne, |a, b| el.element.stiffness()[(a, b)]);
-            let se = &s * &ee;
-            k += ee.transpose() * se;
-        }
-        for c in &mech.controllers {
-            let row: Vec<f64> = match c.on {
-                Coordinate::Node(i) => (0..n_q).map(|k| f[(i, k)]).collect(),
-                Coordinate::Def(j) => (0..n_q).map(|k| e[(j, k)]).collect(),
+                )
             };
-            for a in 0..n_q {
-                for b in 0..n_q {
-                    k[(a, b)] += c.kp * row[a] * row[b];
+            for col in 0..n_q {
+                let ecol = e.col_as_slice(col);
+                for a in 0..ne {
+                    if !active(a) {
+                        continue;
+                    }
+                    ef[(o + a, col)] = ecol[o + a];
+                    let mut v = gains[o + a] * ecol[o + a];
+                    for b in 0..ne {
+                        if active(b) {
+                            v += s[(a, b)] * ecol[o + b];
+                        }
+                    }
+                    se[(o + a, col)] = v;
+                }
+            }
+        }
+        let mut k = Mat::<f64>::zeros(n_q, n_q);
+        faer::linalg::matmul::matmul(
+            k.as_mut(),
+            faer::Accum::Replace,
+            ef.transpose(),
+            se.as_ref(),
+            1.0,
+            faer::Par::Seq,
+        );
+        for c in &mech.controllers {
+            if let Coordinate::Node(i) = c.on {
+                let row: Vec<f64> = (0..n_q).map(|k| f[(i, k)]).collect();
+                for a in 0..n_q {
+                    for b in 0..n_q {
+                        k[(a, b)] += c.kp * row[a] * row[b];
+                    }
                 }
             }
         }
@@ -178,15 +211,15 @@ impl Dynamics {
         let n_q = self.mech.n_dof();
         let mut q = q0.to_vec();
         let mut held = vec![false; n_q];
-        for &(i, v) in &opts.held {
+        for &(i, _) in &opts.held {
             if i >= n_q {
                 return Err(DynamicsError::Invalid(format!(
                     "held DOF index {i} ≥ {n_q}"
                 )));
             }
             held[i] = true;
-            q[i] = v;
         }
+        let held_start: Vec<f64> = opts.held.iter().map(|(i, _)| q0[*i]).collect();
         let free: Vec<usize> = (0..n_q).filter(|i| !held[*i]).collect();
         let mut lambda = 0.0;
         let mut dl = 1.0 / opts.load_steps.max(1) as f64;
@@ -197,7 +230,10 @@ impl Dynamics {
         let mut lu = DenseLu::default();
         while lambda < 1.0 - 1e-15 {
             let target = (lambda + dl).min(1.0);
-            self.load_factor = target;
+            self.load_factor = if opts.ramp_loads { target } else { 1.0 };
+            for (k, &(i, v)) in opts.held.iter().enumerate() {
+                q[i] = held_start[k] + target * (v - held_start[k]);
+            }
             let mut converged = false;
             for _it in 0..opts.max_iterations {
                 iterations += 1;

@@ -1058,10 +1058,13 @@ impl Kinematics {
         let mut buf = Mat::zeros(y.len(), 1);
         self.lu.solve_transpose_vec(&mut y, &mut buf);
         let mu = y;
-        let mut g = Mat::<f64>::zeros(n_q, n_q);
+        // HF = Σ_e scatter(H_e F_e), then G = F,qᵀ HF with one product
+        let n_x = mech.n_x();
+        let mut hf = Mat::<f64>::zeros(n_x, n_q);
         let mut xl = [0.0; 64];
         let mut wl = [0.0; 64];
         let mut h = vec![0.0; 64 * 64];
+        let mut fl = [0.0; 64];
         for (ei, e) in mech.elements.iter().enumerate() {
             let m = &self.maps[ei];
             if m.ne == 0 {
@@ -1085,11 +1088,43 @@ impl Kinematics {
             let nx = m.nx;
             e.element
                 .deformation_weighted_hessian(&xl[..nx], &wl[..m.ne], &mut h[..nx * nx]);
-            // G += F_eᵀ H F_e
-            let fe = Mat::from_fn(nx, n_q, |a, c| self.f[(e.x_index[a], c)]);
-            let he = Mat::from_fn(nx, nx, |a, b| h[a * nx + b]);
-            let hf = &he * &fe;
-            g += fe.transpose() * hf;
+            for c in 0..n_q {
+                let fcol = self.f.col_as_slice(c);
+                let mut nz = false;
+                for (a, gi) in e.x_index.iter().enumerate() {
+                    fl[a] = fcol[*gi];
+                    nz |= fl[a] != 0.0;
+                }
+                if !nz {
+                    continue;
+                }
+                let out = hf.col_as_slice_mut(c);
+                for (a, gi) in e.x_index.iter().enumerate() {
+                    let row = &h[a * nx..a * nx + nx];
+                    let mut s = 0.0;
+                    for b in 0..nx {
+                        s += row[b] * fl[b];
+                    }
+                    out[*gi] += s;
+                }
+            }
+        }
+        let mut g = Mat::<f64>::zeros(n_q, n_q);
+        faer::linalg::matmul::matmul(
+            g.as_mut(),
+            faer::Accum::Replace,
+            self.f.subcols(0, n_q).transpose(),
+            hf.as_ref(),
+            1.0,
+            faer::Par::Seq,
+        );
+        // symmetric by construction up to rounding
+        for r in 0..n_q {
+            for c in r + 1..n_q {
+                let v = 0.5 * (g[(r, c)] + g[(c, r)]);
+                g[(r, c)] = v;
+                g[(c, r)] = v;
+            }
         }
         g
     }

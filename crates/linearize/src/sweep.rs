@@ -10,6 +10,9 @@ use flexmb_model::Mechanism;
 use rayon::prelude::*;
 use std::sync::Arc;
 
+/// Modes and mass matrices of one worker's block of configurations.
+type BlockResult = Result<Vec<(Modes, Mat<f64>)>, LinearizeError>;
+
 /// What varies along the sweep.
 pub enum SweepParameter {
     /// The nodal loads are scaled by s (gravity stays).
@@ -67,7 +70,11 @@ pub fn sweep(
     let mut qs = Vec::with_capacity(n);
     // phase 1: equilibria by continuation
     for (i, &s) in opts.values.iter().enumerate() {
-        let mut so = StaticOptions::default();
+        // the first equilibrium ramps the loads; the next ones continue from it
+        let mut so = StaticOptions {
+            ramp_loads: i == 0,
+            ..Default::default()
+        };
         match param {
             SweepParameter::LoadScale => dy.set_load_scale(s),
             SweepParameter::Dof(k) => so.held = vec![(*k, s)],
@@ -100,7 +107,7 @@ pub fn sweep(
         })
         .collect();
     let chunk = n.div_ceil(rayon::current_num_threads().max(1)).max(1);
-    let results: Vec<Result<Vec<(Modes, Mat<f64>)>, LinearizeError>> = qs
+    let results: Vec<BlockResult> = qs
         .par_chunks(chunk)
         .enumerate()
         .map(|(c, block)| {
