@@ -1,0 +1,90 @@
+//! Sweeps along a path of several held coordinates (thesis (4.1)) with MAC
+//! tracking of the modes, and mode shapes in nodal coordinates.
+
+use flexmb_dynamics::Dynamics;
+use flexmb_linearize::*;
+use flexmb_model::{Component, Scene, Select};
+use std::path::Path;
+use std::sync::Arc;
+
+fn guidance(first: Vec<Select>) -> Arc<flexmb_model::Mechanism> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes/straight_guidance_spatial.ron");
+    let mut s = Scene::load(&p).unwrap();
+    s.dofs_first = first;
+    Arc::new(s.build(None).unwrap())
+}
+
+#[test]
+fn path_sweep_holds_every_path_coordinate_and_tracks_modes() {
+    // hold the body's x and z on a path P(s) = (x0 + s, z0 − 0.01 s): the
+    // equilibrium carries gravity and the reactions of both held coordinates
+    let mech = guidance(vec![
+        Select::Coord("S".into(), Component::X),
+        Select::Coord("S".into(), Component::Z),
+    ]);
+    let q0 = mech.q0();
+    let (x0, z0) = (q0[0], q0[1]);
+    let param = SweepParameter::Path {
+        dofs: vec![0, 1],
+        path: Box::new(move |s| vec![x0 + s, z0 - 0.01 * s]),
+    };
+    let values: Vec<f64> = (0..11).map(|i| 0.008 * i as f64).collect();
+    let pts = sweep(
+        &mech,
+        &param,
+        &SweepOptions {
+            values: values.clone(),
+            modes: 4,
+            t: 0.0,
+            keep_vectors: true,
+        },
+        &|_, _| {},
+    )
+    .unwrap();
+    for (p, s) in pts.iter().zip(&values) {
+        assert!((p.q[0] - (x0 + s)).abs() < 1e-12 && (p.q[1] - (z0 - 0.01 * s)).abs() < 1e-12);
+        assert!(
+            p.frequencies_hz.iter().all(|f| f.is_finite() && *f > 0.0),
+            "{:?}",
+            p.frequencies_hz
+        );
+    }
+    let sets: Vec<faer::Mat<f64>> = pts.iter().map(|p| p.modes.clone().unwrap()).collect();
+    let masses: Vec<faer::Mat<f64>> = pts.iter().map(|p| p.mass.clone().unwrap()).collect();
+    let tr = track_modes(&sets, Some(&masses));
+    for t in 0..4 {
+        let w = tr.confidence.iter().map(|c| c[t]).fold(1.0f64, f64::min);
+        eprintln!("track {t}: lowest MAC with the previous configuration {w:.3}");
+    }
+    // the lowest constrained mode (an in-plane flexure mode) is followed with
+    // a high MAC between neighbouring configurations
+    let w0 = tr.confidence.iter().map(|c| c[0]).fold(1.0f64, f64::min);
+    assert!(w0 > 0.9, "tracking confidence of the first mode {w0}");
+}
+
+#[test]
+fn mode_shapes_in_nodal_coordinates_move_the_body_in_x_for_the_first_mode() {
+    let mut s = Scene::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/scenes/straight_guidance_spatial.ron"),
+    )
+    .unwrap();
+    s.gravity = None;
+    let mech = Arc::new(s.build(None).unwrap());
+    let mut dy = Dynamics::new(mech.clone());
+    let q0 = mech.q0();
+    let lin = dy.linearize_at_rest(0.0, &q0).unwrap();
+    let modes = undamped_modes(&lin, 2).unwrap();
+    let shapes = nodal_mode_shapes(&dy, &modes.vectors);
+    let sx = mech.node("S").unwrap().position.clone();
+    // mode 1: translation of the body along x; mode 2: out-of-plane (z)
+    let (ux, uy, uz) = (
+        shapes[(sx[0], 0)].abs(),
+        shapes[(sx[1], 0)].abs(),
+        shapes[(sx[2], 0)].abs(),
+    );
+    assert!(ux > 100.0 * uy.max(uz), "mode 1 at S: ({ux}, {uy}, {uz})");
+    let (vx, vz) = (shapes[(sx[0], 1)].abs(), shapes[(sx[2], 1)].abs());
+    assert!(vz > 100.0 * vx, "mode 2 at S: x {vx}, z {vz}");
+}
