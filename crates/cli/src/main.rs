@@ -383,6 +383,19 @@ fn simulate(
     let svg = out.join("outputs.svg");
     plot.save(&svg).map_err(|e| io_err(e, &svg))?;
     println!("wrote {} and {}", csv.display(), svg.display());
+    // the path of every node whose position is an output (e.g. a manipulator tip)
+    for (k, h) in table.header.iter().enumerate() {
+        if let Some(node) = h.strip_suffix(".x") {
+            if table.header.get(k + 1).map(|n| n.as_str()) == Some(&format!("{node}.y")) {
+                let x: Vec<f64> = rows.iter().map(|r| r[k + 1]).collect();
+                let y: Vec<f64> = rows.iter().map(|r| r[k + 2]).collect();
+                let p = Plot::new(&format!("path of {node}"), "x (m)", "y (m)").series(Series::line(node, &x, &y));
+                let f = out.join(format!("path_{node}.svg"));
+                p.save(&f).map_err(|e| io_err(e, &f))?;
+                println!("wrote {}", f.display());
+            }
+        }
+    }
     if traj.stopped {
         return Err(Failure::Interrupted);
     }
