@@ -389,7 +389,8 @@ fn simulate(
             if table.header.get(k + 1).map(|n| n.as_str()) == Some(&format!("{node}.y")) {
                 let x: Vec<f64> = rows.iter().map(|r| r[k + 1]).collect();
                 let y: Vec<f64> = rows.iter().map(|r| r[k + 2]).collect();
-                let p = Plot::new(&format!("path of {node}"), "x (m)", "y (m)").series(Series::line(node, &x, &y));
+                let p = Plot::new(&format!("path of {node}"), "x (m)", "y (m)")
+                    .series(Series::line(node, &x, &y));
                 let f = out.join(format!("path_{node}.svg"));
                 p.save(&f).map_err(|e| io_err(e, &f))?;
                 println!("wrote {}", f.display());

@@ -361,6 +361,23 @@ impl Dynamics {
         self.load_scale = s;
     }
 
+    /// Mq and the generalized force F,qᵀ(f − Mx ẍ0 − h) − E,qᵀσ at (t, q, q̇)
+    /// with ẍ0 the accelerations for q̈ = 0: the pieces of (D.10) that a
+    /// reduced model q = G(z) projects (thesis (6.15)).
+    pub fn mass_and_force(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+    ) -> Result<(&Mat<f64>, &[f64]), DynamicsError> {
+        self.evaluations += 1;
+        self.kinematics_at(t, q, Some(qd))?;
+        self.forces(t, true);
+        self.inertia(true);
+        self.generalized_force();
+        Ok((&self.mq, &self.rhs))
+    }
+
     /// The mass matrix Mq of the last evaluation.
     pub fn mass_matrix(&self) -> &Mat<f64> {
         &self.mq

@@ -1,0 +1,174 @@
+//! Bases of the constraint q = G(z): the fixed basis G = q0 + Vη (6.16) with
+//! modal and SVD-modal vectors.
+
+use crate::ReductionError;
+use faer::Mat;
+use flexmb_dynamics::Dynamics;
+use flexmb_linearize::{generalized_symmetric, undamped_modes, SweepPoint};
+use flexmb_model::Mechanism;
+use std::sync::Arc;
+
+/// A constraint q = G(z).
+pub trait Basis: Send {
+    /// Number of reduced coordinates z.
+    fn n_z(&self) -> usize;
+    /// Number of full coordinates q.
+    fn n_q(&self) -> usize;
+    /// q = G(z), G,z (n_q × n_z) and the convective term (G,zz ż)ż.
+    fn eval(&self, z: &[f64], zd: &[f64], q: &mut [f64], gz: &mut Mat<f64>, conv: &mut [f64]);
+}
+
+/// The fixed basis G = q0 + V η (thesis (6.16)): G,z = V, G,zz = 0.
+#[derive(Clone, Debug)]
+pub struct FixedBasis {
+    /// Offset q0.
+    pub q0: Vec<f64>,
+    /// Basis vectors (n_q × r).
+    pub v: Mat<f64>,
+}
+
+impl Basis for FixedBasis {
+    fn n_z(&self) -> usize {
+        self.v.ncols()
+    }
+    fn n_q(&self) -> usize {
+        self.v.nrows()
+    }
+    fn eval(&self, z: &[f64], _zd: &[f64], q: &mut [f64], gz: &mut Mat<f64>, conv: &mut [f64]) {
+        q.copy_from_slice(&self.q0);
+        for (k, zk) in z.iter().enumerate() {
+            for (qi, vi) in q.iter_mut().zip(self.v.col_as_slice(k)) {
+                *qi += vi * zk;
+            }
+        }
+        gz.copy_from(&self.v);
+        conv.fill(0.0);
+    }
+}
+
+/// The modal basis of thesis §5.3.2: the first `r` undamped modes at the
+/// configuration `q` (rest linearization (E.6)). With `large` = the indices of
+/// coordinates that undergo large motion (ql of (5.20)), those are kept
+/// (V_l = I) and the modes are computed for the small coordinates qs with ql
+/// fixed (5.21).
+pub fn modal_basis(
+    mech: &Arc<Mechanism>,
+    t: f64,
+    q: &[f64],
+    r: usize,
+    large: Option<&[usize]>,
+) -> Result<FixedBasis, ReductionError> {
+    let n = mech.n_dof();
+    let mut dy = Dynamics::new(mech.clone());
+    let lin = dy.linearize_at_rest(t, q)?;
+    let large: Vec<usize> = large.map(|l| l.to_vec()).unwrap_or_default();
+    if large.iter().any(|i| *i >= n) {
+        return Err(ReductionError::Invalid(format!(
+            "large-coordinate index out of range (n_q = {n})"
+        )));
+    }
+    let small: Vec<usize> = (0..n).filter(|i| !large.contains(i)).collect();
+    if r > small.len() {
+        return Err(ReductionError::Invalid(format!(
+            "{r} modes requested but only {} small coordinates",
+            small.len()
+        )));
+    }
+    let k = lin.stiffness_total();
+    let ks = Mat::from_fn(small.len(), small.len(), |a, b| k[(small[a], small[b])]);
+    let ms = Mat::from_fn(small.len(), small.len(), |a, b| lin.m[(small[a], small[b])]);
+    let modes = generalized_symmetric(&ks, &ms, r)?;
+    let cols = large.len() + r;
+    let mut v = Mat::<f64>::zeros(n, cols);
+    for (c, i) in large.iter().enumerate() {
+        v[(*i, c)] = 1.0;
+    }
+    for j in 0..r {
+        // normalized vectors (the thesis normalizes, §5.3.2)
+        let nrm = (0..small.len())
+            .map(|a| modes.vectors[(a, j)].powi(2))
+            .sum::<f64>()
+            .sqrt();
+        for (a, i) in small.iter().enumerate() {
+            v[(*i, large.len() + j)] = modes.vectors[(a, j)] / nrm;
+        }
+    }
+    Ok(FixedBasis { q0: q.to_vec(), v })
+}
+
+/// The result of an SVD-modal analysis (thesis §5.3.3).
+#[derive(Clone, Debug)]
+pub struct SvdModal {
+    /// The basis (the retained left singular vectors).
+    pub basis: FixedBasis,
+    /// All singular values, descending.
+    pub singular_values: Vec<f64>,
+    /// Singular values relative to their sum (the thesis's Fig. 5.4 scale).
+    pub relative: Vec<f64>,
+}
+
+/// SVD-modal basis (5.22)–(5.23): the first `r` normalized modes of each
+/// configuration weighted by ω^−a, concatenated, one SVD; the left singular
+/// vectors whose singular value exceeds `threshold` (the thesis's 1 % = 0.01)
+/// of the sum are kept. `points` must carry mode shapes (sweep with
+/// `keep_vectors`).
+pub fn svd_modal_basis(
+    q0: &[f64],
+    points: &[SweepPoint],
+    r: usize,
+    a: f64,
+    threshold: f64,
+) -> Result<SvdModal, ReductionError> {
+    let n = q0.len();
+    let mut cols: Vec<Vec<f64>> = vec![];
+    for p in points {
+        let v = p
+            .modes
+            .as_ref()
+            .ok_or_else(|| ReductionError::Invalid("sweep points carry no mode shapes".into()))?;
+        if v.ncols() < r {
+            return Err(ReductionError::Invalid(format!(
+                "a sweep point has {} modes, {r} needed",
+                v.ncols()
+            )));
+        }
+        for j in 0..r {
+            let w = (2.0 * std::f64::consts::PI * p.frequencies_hz[j].abs()).powf(-a);
+            let nrm = v.col_as_slice(j).iter().map(|x| x * x).sum::<f64>().sqrt();
+            cols.push(v.col_as_slice(j).iter().map(|x| x / nrm * w).collect());
+        }
+    }
+    let qs = Mat::from_fn(n, cols.len(), |i, j| cols[j][i]);
+    let svd = qs
+        .thin_svd()
+        .map_err(|_| ReductionError::Invalid("SVD did not converge".into()))?;
+    let s = svd.S().column_vector();
+    let sv: Vec<f64> = (0..s.nrows()).map(|i| s[i]).collect();
+    let sum: f64 = sv.iter().sum();
+    let relative: Vec<f64> = sv.iter().map(|x| x / sum).collect();
+    let keep = relative.iter().filter(|x| **x > threshold).count().max(1);
+    let u = svd.U();
+    let v = Mat::from_fn(n, keep, |i, j| u[(i, j)]);
+    Ok(SvdModal {
+        basis: FixedBasis { q0: q0.to_vec(), v },
+        singular_values: sv,
+        relative,
+    })
+}
+
+/// Undamped eigenfrequencies (Hz) of a reduced fixed-basis model at rest at
+/// z = 0: Mz = VᵀMqV, Kz = Vᵀ(K + G + N)V (thesis (F.7) with G,zz = 0).
+pub fn fixed_basis_frequencies(
+    mech: &Arc<Mechanism>,
+    t: f64,
+    basis: &FixedBasis,
+    count: usize,
+) -> Result<Vec<f64>, ReductionError> {
+    let mut dy = Dynamics::new(mech.clone());
+    let lin = dy.linearize_at_rest(t, &basis.q0)?;
+    let v = &basis.v;
+    let mz = v.transpose() * &lin.m * v;
+    let kz = v.transpose() * lin.stiffness_total() * v;
+    let _ = undamped_modes;
+    Ok(generalized_symmetric(&kz, &mz, count)?.frequencies_hz())
+}

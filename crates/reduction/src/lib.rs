@@ -1,0 +1,53 @@
+//! System model reduction that keeps the geometric non-linearity (thesis
+//! chapters 5–6): the degrees of freedom q are constrained to q = G(z)
+//! (6.12) and the equations of motion are projected (6.15):
+//!
+//! Mz z̈ = G,zᵀ (F,qᵀ(f − Mx ẍ0) − E,qᵀσ − Mq (G,zz ż)ż),  Mz = G,zᵀ Mq G,z,
+//!
+//! with ẍ0 the accelerations of the transfer functions for q̈ = 0 at
+//! q̇ = G,z ż. The transfer functions stay non-linear; only the coordinates are
+//! reduced.
+//!
+//! This crate provides the general reduced model over any [`Basis`] and the
+//! fixed basis method G = q0 + Vη (6.16) with modal (5.21) and SVD-modal
+//! (5.22)–(5.23) bases. The interpolated basis method is future work.
+//!
+//! ```
+//! use flexmb_reduction::{FixedBasis, ReducedModel};
+//! use flexmb_model::Scene;
+//! use std::sync::Arc;
+//! let scene = Scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/scenes/straight_guidance_planar.ron"))).unwrap();
+//! let mech = Arc::new(scene.build(None).unwrap());
+//! // the first three modes at rest (MODAL-3 of thesis §5.4.1)
+//! let basis = flexmb_reduction::modal_basis(&mech, 0.0, &mech.q0(), 3, None).unwrap();
+//! let mut red = ReducedModel::new(mech.clone(), Box::new(basis));
+//! let mut zdd = vec![0.0; 3];
+//! red.accelerations(0.05, &[0.0; 3], &[0.0; 3], &mut zdd).unwrap();
+//! assert!(zdd.iter().any(|v| v.abs() > 0.0)); // the force pulse drives the reduced model
+//! ```
+#![warn(missing_docs)]
+
+mod basis;
+mod model;
+
+pub use basis::{
+    fixed_basis_frequencies, modal_basis, svd_modal_basis, Basis, FixedBasis, SvdModal,
+};
+pub use model::ReducedModel;
+
+/// Failures of the reduction layer.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum ReductionError {
+    /// The unreduced dynamics failed.
+    #[error("{0}")]
+    Dynamics(#[from] flexmb_dynamics::DynamicsError),
+    /// An eigen-analysis failed.
+    #[error("{0}")]
+    Linearize(#[from] flexmb_linearize::LinearizeError),
+    /// Inconsistent input.
+    #[error("{0}")]
+    Invalid(String),
+    /// The reduced mass matrix is singular (dependent basis vectors).
+    #[error("the reduced mass matrix is not positive definite: the basis vectors are linearly dependent or carry no inertia")]
+    SingularMass,
+}

@@ -1,0 +1,138 @@
+//! The fixed basis method: V = I reproduces the unreduced model exactly; a
+//! modal basis keeps the retained eigenfrequencies at its configuration; the
+//! SVD-modal basis reports its singular values.
+
+use faer::Mat;
+use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions};
+use flexmb_linearize::{sweep, undamped_modes, SweepOptions, SweepParameter};
+use flexmb_model::{Component, Mechanism, Scene, Select};
+use flexmb_ode::{Dopri5, Dopri5Options, Output, Tolerance};
+use flexmb_reduction::*;
+use std::path::Path;
+use std::sync::Arc;
+
+fn planar_guidance() -> Arc<Mechanism> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes/straight_guidance_planar.ron");
+    Arc::new(Scene::load(&p).unwrap().build(None).unwrap())
+}
+
+#[test]
+fn identity_basis_reproduces_the_unreduced_trajectory_and_frequencies() {
+    let mech = planar_guidance();
+    let n = mech.n_dof();
+    let q0 = mech.q0();
+    let basis = FixedBasis {
+        q0: q0.clone(),
+        v: Mat::identity(n, n),
+    };
+    let times: Vec<f64> = (0..21).map(|i| 0.01 * i as f64).collect();
+    // unreduced, DOPRI5 at tight tolerances
+    let mut dy = Dynamics::new(mech.clone());
+    let mut opts = SimulationOptions::new(Integrator::Dopri5, 0.0, 0.2, 21);
+    opts.rtol = 1e-8;
+    opts.atol = 1e-11;
+    let full = dy
+        .simulate(0.0, &q0, &vec![0.0; n], &opts, |_, _, _| Control::Continue)
+        .unwrap();
+    // reduced with V = I, the same integrator and settings
+    let mut red = ReducedModel::new(mech.clone(), Box::new(basis.clone()));
+    let o = Dopri5Options {
+        rtol: 1e-8,
+        atol: Tolerance::Scalar(1e-11),
+        ..Default::default()
+    };
+    let sol = Dopri5::new(o)
+        .solve(&mut red, 0.0, &vec![0.0; 2 * n], 0.2, &Output::Times(times))
+        .unwrap();
+    assert_eq!(sol.stats.rhs_evals, full.stats.rhs_evals, "the same steps");
+    let mut worst = 0.0f64;
+    let mut scale = 0.0f64;
+    for (i, qf) in full.q.iter().enumerate() {
+        let z = sol.y(i);
+        for k in 0..n {
+            worst = worst.max((q0[k] + z[k] - qf[k]).abs());
+            scale = scale.max(qf[k].abs());
+        }
+    }
+    assert!(
+        worst <= 1e-12 * scale.max(1e-6),
+        "trajectories differ by {worst:e}"
+    );
+    let f_full = undamped_modes(
+        &Dynamics::new(mech.clone())
+            .linearize_at_rest(0.0, &q0)
+            .unwrap(),
+        n,
+    )
+    .unwrap()
+    .frequencies_hz();
+    let f_red = fixed_basis_frequencies(&mech, 0.0, &basis, n).unwrap();
+    for (a, b) in f_full.iter().zip(&f_red) {
+        assert!((a / b - 1.0).abs() < 1e-10, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn modal_basis_keeps_its_eigenfrequencies() {
+    // MODAL-3 of thesis §5.4.1: the three retained modes' frequencies at the
+    // configuration are exactly those of the unreduced model
+    let mech = planar_guidance();
+    let q0 = mech.q0();
+    let basis = modal_basis(&mech, 0.0, &q0, 3, None).unwrap();
+    let f_red = fixed_basis_frequencies(&mech, 0.0, &basis, 3).unwrap();
+    let f_full = undamped_modes(
+        &Dynamics::new(mech.clone())
+            .linearize_at_rest(0.0, &q0)
+            .unwrap(),
+        3,
+    )
+    .unwrap()
+    .frequencies_hz();
+    for (a, b) in f_full.iter().zip(&f_red) {
+        assert!((a / b - 1.0).abs() < 1e-9, "{a} vs {b}");
+    }
+    // the reduced model integrates: the pulse moves the body
+    let mut red = ReducedModel::new(mech.clone(), Box::new(basis));
+    let sol = Dopri5::new(Dopri5Options::default())
+        .solve(&mut red, 0.0, &[0.0; 6], 0.2, &Output::Final)
+        .unwrap();
+    let z = sol.last().unwrap().1.to_vec();
+    assert!(z[..3].iter().any(|v| v.abs() > 1e-6));
+}
+
+#[test]
+fn svd_modal_basis_from_ten_configurations() {
+    // SVDm of thesis §5.4.1: first three modes in ten equidistant
+    // configurations over the stroke, weight exponents a = 0 and a = 1, 1 % rule
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes/straight_guidance_planar.ron");
+    let mut s = Scene::load(&p).unwrap();
+    s.dofs_first = vec![Select::Coord("S".into(), Component::X)];
+    let swept = Arc::new(s.build(None).unwrap());
+    let x0 = swept.q0()[0];
+    let values: Vec<f64> = (0..10).map(|i| x0 + 0.0833 * i as f64 / 9.0).collect();
+    let pts = sweep(
+        &swept,
+        &SweepParameter::Dof(0),
+        &SweepOptions {
+            values,
+            modes: 4,
+            t: 0.0,
+            keep_vectors: true,
+        },
+        &|_, _| {},
+    )
+    .unwrap();
+    for a in [0.0, 1.0] {
+        let svd = svd_modal_basis(&swept.q0(), &pts, 3, a, 0.01).unwrap();
+        let kept = svd.basis.v.ncols();
+        eprintln!(
+            "a = {a}: {kept} singular vectors above 1 %, relative values {:?}",
+            &svd.relative[..8.min(svd.relative.len())]
+        );
+        assert!(svd.relative.windows(2).all(|w| w[0] >= w[1]));
+        assert!((svd.relative.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        assert!((3..=10).contains(&kept), "{kept}");
+    }
+}
