@@ -8,9 +8,12 @@
 //! q̇ = G,z ż. The transfer functions stay non-linear; only the coordinates are
 //! reduced.
 //!
-//! This crate provides the general reduced model over any [`Basis`] and the
+//! This crate provides the general reduced model over any [`Basis`], the
 //! fixed basis method G = q0 + Vη (6.16) with modal (5.21) and SVD-modal
-//! (5.22)–(5.23) bases. The interpolated basis method is future work.
+//! (5.22)–(5.23) bases, and the interpolated basis method (6.23) with cubic
+//! splines and modal subspace interpolation (§6.3.3) or MAC-sorted
+//! eigenvectors. Not yet: per-mode SVD (6.19)–(6.21), the path eigenvectors of
+//! chapter 7, the reduced linearization (F.5), saving models, the CLI.
 //!
 //! ```
 //! use flexmb_reduction::{FixedBasis, ReducedModel};
@@ -28,12 +31,18 @@
 #![warn(missing_docs)]
 
 mod basis;
+mod ibm;
 mod model;
+mod msi;
+mod spline;
 
 pub use basis::{
     fixed_basis_frequencies, modal_basis, svd_modal_basis, Basis, FixedBasis, SvdModal,
 };
+pub use ibm::{InterpolatedBasis, SubspaceInterpolation};
 pub use model::ReducedModel;
+pub use msi::{largest_principal_angle, mac_sorted, modal_subspace_interpolation, orthonormalize};
+pub use spline::CubicSpline;
 
 /// Failures of the reduction layer.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

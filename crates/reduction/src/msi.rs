@@ -1,0 +1,96 @@
+//! Modal subspace interpolation (thesis §6.3.3, steps 1–8) and the MAC-sorted
+//! alternative.
+
+use faer::Mat;
+
+/// Orthonormalizes the columns (Gram–Schmidt twice), step 1.
+pub fn orthonormalize(v: &Mat<f64>) -> Mat<f64> {
+    let (n, r) = (v.nrows(), v.ncols());
+    let mut q = v.clone();
+    for j in 0..r {
+        for _ in 0..2 {
+            for k in 0..j {
+                let p: f64 = (0..n).map(|i| q[(i, k)] * q[(i, j)]).sum();
+                for i in 0..n {
+                    q[(i, j)] -= p * q[(i, k)];
+                }
+            }
+        }
+        let nrm = (0..n).map(|i| q[(i, j)].powi(2)).sum::<f64>().sqrt();
+        for i in 0..n {
+            q[(i, j)] /= nrm;
+        }
+    }
+    q
+}
+
+/// Steps 1–7 of the MSI algorithm: the base vectors W(i) that span the same
+/// subspaces as the eigenvectors V(i) but vary as little as possible from one
+/// configuration to the next (steps 3–6: W(i+1) = normalized columns of
+/// V(i+1)V(i+1)ᵀW(i)), then mass-normalized with M(i) (step 7, (6.26)) when
+/// mass matrices are given. Step 8 (interpolation) is done by the caller.
+pub fn modal_subspace_interpolation(v: &[Mat<f64>], mass: Option<&[Mat<f64>]>) -> Vec<Mat<f64>> {
+    let vs: Vec<Mat<f64>> = v.iter().map(orthonormalize).collect();
+    let mut w: Vec<Mat<f64>> = Vec::with_capacity(vs.len());
+    if vs.is_empty() {
+        return w;
+    }
+    w.push(vs[0].clone());
+    for i in 0..vs.len() - 1 {
+        let vn = &vs[i + 1];
+        let proj = vn * (vn.transpose() * &w[i]);
+        let (n, r) = (proj.nrows(), proj.ncols());
+        let mut next = proj;
+        for j in 0..r {
+            let nrm = (0..n).map(|k| next[(k, j)].powi(2)).sum::<f64>().sqrt();
+            for k in 0..n {
+                next[(k, j)] /= nrm;
+            }
+        }
+        w.push(next);
+    }
+    if let Some(m) = mass {
+        for (wi, mi) in w.iter_mut().zip(m) {
+            let mw = mi * &*wi;
+            for j in 0..wi.ncols() {
+                let s: f64 = (0..wi.nrows()).map(|k| wi[(k, j)] * mw[(k, j)]).sum();
+                let f = 1.0 / s.sqrt();
+                for k in 0..wi.nrows() {
+                    wi[(k, j)] *= f;
+                }
+            }
+        }
+    }
+    w
+}
+
+/// The alternative of the thesis's MAC-7 model: eigenvectors sorted by MAC mode
+/// tracking and sign-aligned with the previous configuration.
+pub fn mac_sorted(v: &[Mat<f64>]) -> Vec<Mat<f64>> {
+    let tr = flexmb_linearize::track_modes(v, None);
+    let mut out: Vec<Mat<f64>> = vec![];
+    for (i, vi) in v.iter().enumerate() {
+        let mut m = Mat::from_fn(vi.nrows(), vi.ncols(), |r, t| vi[(r, tr.perms[i][t])]);
+        if let Some(prev) = out.last() {
+            for t in 0..m.ncols() {
+                let d: f64 = (0..m.nrows()).map(|r| m[(r, t)] * prev[(r, t)]).sum();
+                if d < 0.0 {
+                    for r in 0..m.nrows() {
+                        m[(r, t)] = -m[(r, t)];
+                    }
+                }
+            }
+        }
+        out.push(m);
+    }
+    out
+}
+
+/// The largest principal angle (radians) between the column spaces of a and b
+/// (of equal dimension), from its sine ‖(I − QaQaᵀ)Qb‖₂ (accurate for small angles).
+pub fn largest_principal_angle(a: &Mat<f64>, b: &Mat<f64>) -> f64 {
+    let (qa, qb) = (orthonormalize(a), orthonormalize(b));
+    let r = &qb - &qa * (qa.transpose() * &qb);
+    let s = r.singular_values().unwrap_or_default();
+    s.iter().copied().fold(0.0f64, f64::max).min(1.0).asin()
+}
