@@ -16,6 +16,11 @@ pub trait Basis: Send {
     fn n_q(&self) -> usize;
     /// q = G(z), G,z (n_q × n_z) and the convective term (G,zz ż)ż.
     fn eval(&self, z: &[f64], zd: &[f64], q: &mut [f64], gz: &mut Mat<f64>, conv: &mut [f64]);
+    /// Σᵢ rᵢ Gᵢ,zz (n_z × n_z): the term G,zzᵀ r of the reduced geometric
+    /// stiffness (F.5e)/(F.7e). Zero for a fixed basis.
+    fn hessian_contraction(&self, _z: &[f64], _r: &[f64]) -> Mat<f64> {
+        Mat::zeros(self.n_z(), self.n_z())
+    }
 }
 
 /// The fixed basis G = q0 + V η (thesis (6.16)): G,z = V, G,zz = 0.

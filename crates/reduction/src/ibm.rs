@@ -109,6 +109,29 @@ impl Basis for InterpolatedBasis {
     fn n_z(&self) -> usize {
         1 + self.r
     }
+    /// (F.6): G,ss = Q'' + V''η, G,sη = V', G,ηη = 0, contracted with r.
+    fn hessian_contraction(&self, z: &[f64], r: &[f64]) -> Mat<f64> {
+        let (s, eta) = (z[0], &z[1..]);
+        let mut wq = self.q.work();
+        self.q.eval(s, &mut wq);
+        let v = self.v_and_derivatives(s);
+        let mut h = Mat::zeros(1 + self.r, 1 + self.r);
+        let mut hss = 0.0;
+        for i in 0..self.n_q {
+            let mut g = wq[2][i];
+            for j in 0..self.r {
+                g += v[2][(i, j)] * eta[j];
+            }
+            hss += r[i] * g;
+        }
+        h[(0, 0)] = hss;
+        for j in 0..self.r {
+            let hsj: f64 = (0..self.n_q).map(|i| r[i] * v[1][(i, j)]).sum();
+            h[(0, 1 + j)] = hsj;
+            h[(1 + j, 0)] = hsj;
+        }
+        h
+    }
     fn n_q(&self) -> usize {
         self.n_q
     }

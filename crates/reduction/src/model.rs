@@ -35,6 +35,10 @@ impl ReducedModel {
     pub fn n_z(&self) -> usize {
         self.basis.n_z()
     }
+    /// Scales the scene's loads (see `Dynamics::set_load_scale`).
+    pub fn set_load_scale(&mut self, s: f64) {
+        self.dy.set_load_scale(s);
+    }
     /// The unreduced dynamics (configuration of the last evaluation).
     pub fn dynamics(&self) -> &Dynamics {
         &self.dy
@@ -83,6 +87,27 @@ impl ReducedModel {
             *v = fz[(k, 0)];
         }
         Ok(())
+    }
+}
+
+impl ReducedModel {
+    /// The reduced rest linearization (thesis (F.7)) at z with ż = 0:
+    /// Mz = G,zᵀ Mq G,z and Kz = G,zᵀ(K + G + N)G,z + G,zzᵀ(−F,qᵀf + E,qᵀσ).
+    pub fn linearize_at_rest(
+        &mut self,
+        t: f64,
+        z: &[f64],
+    ) -> Result<(Mat<f64>, Mat<f64>), ReductionError> {
+        let nz = self.basis.n_z();
+        self.basis
+            .eval(z, &vec![0.0; nz], &mut self.q, &mut self.gz, &mut self.conv);
+        let q = self.q.clone();
+        let lin = self.dy.linearize_at_rest(t, &q)?;
+        let (r, _) = self.dy.static_tangent(t, &q)?;
+        let mz = self.gz.transpose() * &lin.m * &self.gz;
+        let mut kz = self.gz.transpose() * lin.stiffness_total() * &self.gz;
+        kz += &self.basis.hessian_contraction(z, &r);
+        Ok((mz, kz))
     }
 }
 

@@ -158,3 +158,69 @@ fn derivatives_of_g_match_differences() {
         );
     }
 }
+
+#[test]
+fn ibm_from_unconstrained_eigenvectors_reproduces_the_frequencies_at_its_nodes() {
+    // planar straight guidance with the body's x as a DOF, equilibria under
+    // the scaled force (t = 0.05 s, peak of the pulse): at each node the IBM's
+    // span {Q'(s), V(s)} contains the first r eigenvectors, so its reduced rest
+    // linearization (F.7) has the unreduced first r eigenfrequencies
+    use flexmb_dynamics::Dynamics;
+    use flexmb_linearize::{sweep, undamped_modes, SweepOptions, SweepParameter};
+    use flexmb_model::{Component, Scene, Select};
+    use std::sync::Arc;
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes/straight_guidance_planar.ron");
+    let mut sc = Scene::load(&p).unwrap();
+    sc.dofs_first = vec![Select::Coord("S".into(), Component::X)];
+    let mech = Arc::new(sc.build(None).unwrap());
+    let r = 3;
+    let values: Vec<f64> = (0..8).map(|i| 0.1 * i as f64).collect();
+    let pts = sweep(
+        &mech,
+        &SweepParameter::LoadScale,
+        &SweepOptions {
+            values,
+            modes: r,
+            t: 0.05,
+            keep_vectors: true,
+        },
+        &|_, _| {},
+    )
+    .unwrap();
+    let q0 = mech.q0();
+    let s: Vec<f64> = pts.iter().map(|p| p.q[0] - q0[0]).collect();
+    let qs: Vec<Vec<f64>> = pts.iter().map(|p| p.q.clone()).collect();
+    let vecs: Vec<Mat<f64>> = pts.iter().map(|p| p.modes.clone().unwrap()).collect();
+    let basis = InterpolatedBasis::new(
+        q0.clone(),
+        s.clone(),
+        &qs,
+        &vecs,
+        None,
+        SubspaceInterpolation::Msi,
+    )
+    .unwrap();
+    let mut red = ReducedModel::new(mech.clone(), Box::new(basis));
+    for (k, pt) in pts.iter().enumerate() {
+        let mut dy = Dynamics::new(mech.clone());
+        dy.set_load_scale(0.1 * k as f64);
+        let lin = dy.linearize_at_rest(0.05, &pt.q).unwrap();
+        let full = undamped_modes(&lin, r).unwrap().frequencies_hz();
+        let mut z = vec![0.0; 1 + r];
+        z[0] = s[k];
+        // the reduced model sees the same load scale
+        let (mz, kz) = {
+            let dyn_scale = 0.1 * k as f64;
+            red.set_load_scale(dyn_scale);
+            red.linearize_at_rest(0.05, &z).unwrap()
+        };
+        let f_red = generalized_symmetric(&kz, &mz, r).unwrap().frequencies_hz();
+        for (a, b) in full.iter().zip(&f_red) {
+            assert!(
+                (a / b - 1.0).abs() < 1e-8,
+                "node {k}: unreduced {a} Hz vs IBM {b} Hz"
+            );
+        }
+    }
+}
