@@ -727,7 +727,21 @@ impl Adams {
         if sink.initial(x, &y) == Control::Stop {
             return Ok(finish(sink.solution, stats));
         }
-        st.h = o.h0.unwrap_or((t_end - t0).abs()).copysign(tdir);
+        // Like DE, which is called once per output point and starts from the
+        // first output interval: without h0 the initial trial step is the
+        // distance to the first requested output time (the whole interval
+        // otherwise), before the ‖f0‖ rule of `start`.
+        let first_out = match output {
+            Output::Times(ts) => ts
+                .iter()
+                .map(|t| (t - t0).abs())
+                .filter(|d| *d > 0.0)
+                .fold(f64::INFINITY, f64::min),
+            _ => f64::INFINITY,
+        };
+        st.h =
+            o.h0.unwrap_or((t_end - t0).abs().min(first_out))
+                .copysign(tdir);
 
         loop {
             if stats.steps_accepted >= o.max_steps {
