@@ -39,6 +39,33 @@ fn sym(a: &Mat<f64>) -> Mat<f64> {
     Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]))
 }
 
+/// L⁻¹ A L⁻ᵀ (symmetrized) for a lower-triangular Cholesky factor L.
+fn congruence(l: &Mat<f64>, a: &Mat<f64>) -> Mat<f64> {
+    let mut b = a.clone();
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+        l.as_ref(),
+        b.as_mut(),
+        faer::Par::Seq,
+    );
+    let mut bt = b.transpose().to_owned();
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+        l.as_ref(),
+        bt.as_mut(),
+        faer::Par::Seq,
+    );
+    sym(&bt)
+}
+
+/// v = L⁻ᵀ y.
+fn back_substitute(l: &Mat<f64>, mut y: Mat<f64>) -> Mat<f64> {
+    faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+        l.transpose(),
+        y.as_mut(),
+        faer::Par::Seq,
+    );
+    y
+}
+
 /// Solves the generalized symmetric-definite problem K v = λ M v for the `k`
 /// lowest λ (all when `k` ≥ n). M must be positive definite. The problem is
 /// transformed with the Cholesky factor of K when K is positive definite (which
@@ -78,60 +105,22 @@ pub fn generalized_symmetric(
     let count = count.min(n);
     let vectors: Mat<f64> = match ks.llt(Side::Lower) {
         Ok(kllt) => {
-            // K = Lk Lkᵀ: Lk⁻¹ M Lk⁻ᵀ y = (1/λ) y, v = Lk⁻ᵀ y
+            // K = Lk Lkᵀ: Lk⁻¹ M Lk⁻ᵀ y = (1/λ) y, v = Lk⁻ᵀ y; largest 1/λ first
             let l = kllt.L().to_owned();
-            let mut a = ms.clone();
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-                l.as_ref(),
-                a.as_mut(),
-                faer::Par::Seq,
-            );
-            let mut at = a.transpose().to_owned();
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-                l.as_ref(),
-                at.as_mut(),
-                faer::Par::Seq,
-            );
-            let b = sym(&at);
-            let evd = b
+            let evd = congruence(&l, &ms)
                 .self_adjoint_eigen(Side::Lower)
                 .map_err(|_| LinearizeError::NoConvergence)?;
-            // largest 1/λ first = lowest λ
             let u = evd.U();
-            let mut y = Mat::from_fn(n, count, |i, j| u[(i, n - 1 - j)]);
-            faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-                l.transpose(),
-                y.as_mut(),
-                faer::Par::Seq,
-            );
-            y
+            back_substitute(&l, Mat::from_fn(n, count, |i, j| u[(i, n - 1 - j)]))
         }
         Err(_) => {
+            // M = Lm Lmᵀ: Lm⁻¹ K Lm⁻ᵀ y = λ y, v = Lm⁻ᵀ y; smallest λ first
             let l = mllt.L().to_owned();
-            let mut a = ks.clone();
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-                l.as_ref(),
-                a.as_mut(),
-                faer::Par::Seq,
-            );
-            let mut at = a.transpose().to_owned();
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-                l.as_ref(),
-                at.as_mut(),
-                faer::Par::Seq,
-            );
-            let b = sym(&at);
-            let evd = b
+            let evd = congruence(&l, &ks)
                 .self_adjoint_eigen(Side::Lower)
                 .map_err(|_| LinearizeError::NoConvergence)?;
             let u = evd.U();
-            let mut y = Mat::from_fn(n, count, |i, j| u[(i, j)]);
-            faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-                l.transpose(),
-                y.as_mut(),
-                faer::Par::Seq,
-            );
-            y
+            back_substitute(&l, Mat::from_fn(n, count, |i, j| u[(i, j)]))
         }
     };
     // mass-normalize and Rayleigh quotients
@@ -251,19 +240,7 @@ pub fn buckling_factors(lin: &Linearization, count: usize) -> Result<Vec<f64>, L
             *e = -*e;
         }
     }
-    let mut a = g;
-    faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-        l.as_ref(),
-        a.as_mut(),
-        faer::Par::Seq,
-    );
-    let mut at = a.transpose().to_owned();
-    faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-        l.as_ref(),
-        at.as_mut(),
-        faer::Par::Seq,
-    );
-    let vals = sym(&at)
+    let vals = congruence(&l, &g)
         .self_adjoint_eigenvalues(Side::Lower)
         .map_err(|_| LinearizeError::NoConvergence)?;
     // eigenvalues ν of Lk⁻¹(−G)Lk⁻ᵀ: μ = 1/ν for ν > 0
