@@ -653,15 +653,7 @@ impl Element {
                 eps[..$ne].copy_from_slice(&e);
             }};
         }
-        self.dispatch_def(x, prev, |k| match k {
-            KRef::Planar(k) => go!(k, 6, 3),
-            KRef::Truss2(k) => go!(k, 4, 1),
-            KRef::Hinge2(k) => go!(k, 2, 1),
-            KRef::TwoNode(k) => go!(k, 14, 6),
-            KRef::Truss3(k) => go!(k, 6, 1),
-            KRef::Hinge3(k) => go!(k, 8, 3),
-            KRef::Norm(k) => go!(k, 4, 1),
-        });
+        self.dispatch_def(x, prev, |k| each_kernel!(k, go));
         self.copy_modes(x, eps);
     }
 
@@ -710,15 +702,7 @@ impl Element {
                 }
             }};
         }
-        self.dispatch_def(x, prev, |k| match k {
-            KRef::Planar(k) => go!(k, 6, 3),
-            KRef::Truss2(k) => go!(k, 4, 1),
-            KRef::Hinge2(k) => go!(k, 2, 1),
-            KRef::TwoNode(k) => go!(k, 14, 6),
-            KRef::Truss3(k) => go!(k, 6, 1),
-            KRef::Hinge3(k) => go!(k, 8, 3),
-            KRef::Norm(k) => go!(k, 4, 1),
-        });
+        self.dispatch_def(x, prev, |k| each_kernel!(k, go));
         let k = self.mode_count();
         if k > 0 {
             self.copy_modes(x, eps);
@@ -742,15 +726,7 @@ impl Element {
                 out[..$ne].copy_from_slice(&d);
             }};
         }
-        self.dispatch_def(x, None, |k| match k {
-            KRef::Planar(k) => go!(k, 6, 3),
-            KRef::Truss2(k) => go!(k, 4, 1),
-            KRef::Hinge2(k) => go!(k, 2, 1),
-            KRef::TwoNode(k) => go!(k, 14, 6),
-            KRef::Truss3(k) => go!(k, 6, 1),
-            KRef::Hinge3(k) => go!(k, 8, 3),
-            KRef::Norm(k) => go!(k, 4, 1),
-        });
+        self.dispatch_def(x, None, |k| each_kernel!(k, go));
         let k = self.mode_count();
         if k > 0 {
             out[6..6 + k].fill(0.0);
@@ -774,15 +750,7 @@ impl Element {
                 out[..$ne].copy_from_slice(&d);
             }};
         }
-        self.dispatch_def(x, None, |k| match k {
-            KRef::Planar(k) => go!(k, 6, 3),
-            KRef::Truss2(k) => go!(k, 4, 1),
-            KRef::Hinge2(k) => go!(k, 2, 1),
-            KRef::TwoNode(k) => go!(k, 14, 6),
-            KRef::Truss3(k) => go!(k, 6, 1),
-            KRef::Hinge3(k) => go!(k, 8, 3),
-            KRef::Norm(k) => go!(k, 4, 1),
-        });
+        self.dispatch_def(x, None, |k| each_kernel!(k, go));
         let k = self.mode_count();
         if k > 0 {
             out[6..6 + k].fill(0.0);
@@ -804,17 +772,26 @@ impl Element {
                 }
             }};
         }
-        self.dispatch_def(x, None, |k| match k {
-            KRef::Planar(k) => go!(k, 6, 3),
-            KRef::Truss2(k) => go!(k, 4, 1),
-            KRef::Hinge2(k) => go!(k, 2, 1),
-            KRef::TwoNode(k) => go!(k, 14, 6),
-            KRef::Truss3(k) => go!(k, 6, 1),
-            KRef::Hinge3(k) => go!(k, 8, 3),
-            KRef::Norm(k) => go!(k, 4, 1),
-        });
+        self.dispatch_def(x, None, |k| each_kernel!(k, go));
     }
 }
+
+/// Runs the local macro `$go!(kernel, NX, NE)` with the fixed sizes of the
+/// kernel behind a [`KRef`].
+macro_rules! each_kernel {
+    ($kref:expr, $go:ident) => {
+        match $kref {
+            KRef::Planar(k) => $go!(k, 6, 3),
+            KRef::Truss2(k) => $go!(k, 4, 1),
+            KRef::Hinge2(k) => $go!(k, 2, 1),
+            KRef::TwoNode(k) => $go!(k, 14, 6),
+            KRef::Truss3(k) => $go!(k, 6, 1),
+            KRef::Hinge3(k) => $go!(k, 8, 3),
+            KRef::Norm(k) => $go!(k, 4, 1),
+        }
+    };
+}
+use each_kernel;
 
 enum KRef<'a> {
     Planar(&'a PlanarBeamKernel),
