@@ -139,7 +139,8 @@ impl Dynamics {
             }
         }
         if let Some(g0) = mech.gravity {
-            let g = g0.map(|v| v * lf);
+            // the load scale of a load sweep does not scale gravity
+            let g = g0.map(|v| v * self.load_factor);
             let mut xl = [0.0; 64];
             let mut fl = [0.0; 64];
             for e in &mech.elements {

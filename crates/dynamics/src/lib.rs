@@ -44,7 +44,7 @@ pub use eom::{Dynamics, Energies};
 pub use flexmb_ode::{Control, Stats};
 pub use linearize::Linearization;
 pub use outputs::OutputTable;
-pub use simulate::{FirstOrder, Integrator, SimulationOptions, Trajectory};
+pub use simulate::{integrate_explicit, FirstOrder, Integrator, SimulationOptions, Trajectory};
 pub use statics::{StaticOptions, StaticSolution};
 
 /// Failures of the dynamics layer, naming what failed.

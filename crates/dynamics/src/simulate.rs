@@ -83,6 +83,57 @@ pub struct Trajectory {
     pub stopped: bool,
 }
 
+/// Integrates a first-order system y' = f(t, y) with one of the explicit
+/// integrators (Dopri5 or Adams) from (t0, y0) to the last output time of
+/// `opts`; `observer(t, y)` sees each output and may stop the run. Returns
+/// the integrator's statistics and whether the observer stopped it. Reduced
+/// models use this exactly like the unreduced equations of motion.
+pub fn integrate_explicit<S: OdeSystem + ?Sized>(
+    sys: &mut S,
+    opts: &SimulationOptions,
+    t0: f64,
+    y0: &[f64],
+    mut observer: impl FnMut(f64, &[f64]) -> Control,
+) -> Result<(Stats, bool), DynamicsError> {
+    let t_end = *opts
+        .output_times
+        .last()
+        .ok_or_else(|| DynamicsError::Invalid("no output times".into()))?;
+    let out = Output::Times(opts.output_times.clone());
+    let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(e.to_string());
+    let sol = match opts.integrator {
+        Integrator::Dopri5 => {
+            let o = Dopri5Options {
+                rtol: opts.rtol,
+                atol: Tolerance::Scalar(opts.atol),
+                ..Default::default()
+            };
+            Dopri5::new(o)
+                .solve_with(sys, t0, y0, t_end, &out, &mut observer)
+                .map_err(to_err)?
+        }
+        Integrator::Adams => {
+            let o = AdamsOptions {
+                rtol: opts.rtol,
+                atol: Tolerance::Scalar(opts.atol),
+                ..Default::default()
+            };
+            Adams::new(o)
+                .solve_with(sys, t0, y0, t_end, &out, &mut observer)
+                .map_err(to_err)?
+        }
+        Integrator::GeneralizedAlpha => {
+            return Err(DynamicsError::Invalid(
+                "generalized-α needs the residual form (Dynamics::simulate); use dopri5 or adams for first-order systems".into(),
+            ))
+        }
+    };
+    Ok((
+        sol.stats.clone(),
+        !matches!(sol.status, flexmb_ode::Status::Completed),
+    ))
+}
+
 /// Kinematic failures at a trial state are recoverable (a smaller step
 /// reaches a solvable configuration); the others abort the integration.
 fn to_rhs_error(e: DynamicsError) -> RhsError {
@@ -261,33 +312,15 @@ impl Dynamics {
                 let mut y0 = q0.to_vec();
                 y0.extend_from_slice(qd0);
                 let mut sys = self.first_order_system();
-                let mut obs = |t: f64, y: &[f64]| {
-                    traj.t.push(t);
-                    traj.q.push(y[..n].to_vec());
-                    traj.qd.push(y[n..].to_vec());
-                    observer(t, &y[..n], &y[n..])
-                };
-                let sol = if opts.integrator == Integrator::Dopri5 {
-                    let o = Dopri5Options {
-                        rtol: opts.rtol,
-                        atol: Tolerance::Scalar(opts.atol),
-                        ..Default::default()
-                    };
-                    Dopri5::new(o)
-                        .solve_with(&mut sys, t0, &y0, t_end, &out, &mut obs)
-                        .map_err(to_err)?
-                } else {
-                    let o = AdamsOptions {
-                        rtol: opts.rtol,
-                        atol: Tolerance::Scalar(opts.atol),
-                        ..Default::default()
-                    };
-                    Adams::new(o)
-                        .solve_with(&mut sys, t0, &y0, t_end, &out, &mut obs)
-                        .map_err(to_err)?
-                };
-                traj.stats = sol.stats.clone();
-                traj.stopped = !matches!(sol.status, flexmb_ode::Status::Completed);
+                let (stats, stopped) =
+                    integrate_explicit(&mut sys, opts, t0, &y0, |t: f64, y: &[f64]| {
+                        traj.t.push(t);
+                        traj.q.push(y[..n].to_vec());
+                        traj.qd.push(y[n..].to_vec());
+                        observer(t, &y[..n], &y[n..])
+                    })?;
+                traj.stats = stats;
+                traj.stopped = stopped;
             }
             Integrator::GeneralizedAlpha => {
                 let o = GeneralizedAlphaOptions {

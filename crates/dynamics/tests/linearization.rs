@@ -154,3 +154,66 @@ fn linearization_at_rest_equals_the_general_one_without_motion() {
     assert!(diff(&a.g, &b.g) < 1e-9, "{}", diff(&a.g, &b.g));
     assert!(diff(&a.stiffness_total(), &b.stiffness_total()) < 1e-9);
 }
+
+/// A load sweep scales the nodal loads, not gravity: the static
+/// out-of-balance at load scale 0 still carries gravity (and equals the one at
+/// scale 1 while the force pulse is zero), and the static tangent matches
+/// differences of the out-of-balance at a scale ≠ 1 with gravity on.
+#[test]
+fn load_scale_scales_the_loads_but_not_gravity() {
+    let mut dy = dynamics("straight_guidance_spatial.ron", None);
+    let q: Vec<f64> = dy
+        .mechanism()
+        .q0()
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v + 1e-3 * ((i as f64) * 0.7).sin())
+        .collect();
+    dy.set_load_scale(0.0);
+    let (g0, _) = dy.static_tangent(0.0, &q).unwrap();
+    dy.set_load_scale(1.0);
+    let (g1, _) = dy.static_tangent(0.0, &q).unwrap();
+    let gravity_free = {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/scenes/straight_guidance_spatial.ron");
+        let mut s = Scene::load(&p).unwrap();
+        s.gravity = None;
+        let mut d = Dynamics::new(Arc::new(s.build(None).unwrap()));
+        d.static_tangent(0.0, &q).unwrap().0
+    };
+    let diff = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        diff(&g0, &g1) < 1e-12,
+        "gravity must not follow the load scale"
+    );
+    assert!(
+        diff(&g0, &gravity_free) > 1e-3,
+        "gravity acts at load scale 0"
+    );
+    // tangent against central differences at scale 0.4 while the pulse acts
+    let t = 0.05;
+    dy.set_load_scale(0.4);
+    let (_, k) = dy.static_tangent(t, &q).unwrap();
+    let h = 1e-7;
+    for j in [0, 7, 21, 40] {
+        let mut qp = q.clone();
+        qp[j] += h;
+        let mut qm = q.clone();
+        qm[j] -= h;
+        let gp = dy.static_tangent(t, &qp).unwrap().0;
+        let gm = dy.static_tangent(t, &qm).unwrap().0;
+        for i in 0..q.len() {
+            let fd = (gp[i] - gm[i]) / (2.0 * h);
+            assert!(
+                (fd - k[(i, j)]).abs() < 1e-5 * (1.0 + k[(i, j)].abs()),
+                "K[{i},{j}] = {} against {fd}",
+                k[(i, j)]
+            );
+        }
+    }
+}

@@ -4,7 +4,7 @@
 use crate::ReductionError;
 use faer::Mat;
 use flexmb_dynamics::Dynamics;
-use flexmb_linearize::{generalized_symmetric, undamped_modes, SweepPoint};
+use flexmb_linearize::{generalized_symmetric, SweepPoint};
 use flexmb_model::Mechanism;
 use std::sync::Arc;
 
@@ -20,6 +20,11 @@ pub trait Basis: Send {
     /// stiffness (F.5e)/(F.7e). Zero for a fixed basis.
     fn hessian_contraction(&self, _z: &[f64], _r: &[f64]) -> Mat<f64> {
         Mat::zeros(self.n_z(), self.n_z())
+    }
+    /// The reduced coordinates of the configuration the basis was built
+    /// around (where G(z) is closest to q0): zero for a fixed basis.
+    fn z_reference(&self) -> Vec<f64> {
+        vec![0.0; self.n_z()]
     }
 }
 
@@ -112,6 +117,58 @@ pub struct SvdModal {
     pub relative: Vec<f64>,
 }
 
+/// The normalized `j`-th mode shape of a sweep point (thesis §5.3.3 and step 2
+/// of §6.3.2: normalized eigenvectors, so that no configuration is favoured).
+fn normalized_mode(p: &SweepPoint, j: usize) -> Result<Vec<f64>, ReductionError> {
+    let v = p
+        .modes
+        .as_ref()
+        .ok_or_else(|| ReductionError::Invalid("sweep points carry no mode shapes".into()))?;
+    if v.ncols() <= j {
+        return Err(ReductionError::Invalid(format!(
+            "a sweep point has {} modes, mode {} needed",
+            v.ncols(),
+            j + 1
+        )));
+    }
+    let nrm = v.col_as_slice(j).iter().map(|x| x * x).sum::<f64>().sqrt();
+    Ok(v.col_as_slice(j).iter().map(|x| x / nrm).collect())
+}
+
+/// The singular values of a set of columns and the left singular vectors
+/// whose singular value exceeds `threshold` of the sum (at least one).
+struct KeptSingular {
+    u: Mat<f64>,
+    singular_values: Vec<f64>,
+    relative: Vec<f64>,
+}
+
+fn svd_keep(n: usize, cols: &[Vec<f64>], threshold: f64) -> Result<KeptSingular, ReductionError> {
+    if cols.is_empty() {
+        return Err(ReductionError::Invalid("no vectors to decompose".into()));
+    }
+    if cols.iter().flatten().any(|x| !x.is_finite()) {
+        return Err(ReductionError::Invalid(
+            "a mode shape contains NaN or infinite values".into(),
+        ));
+    }
+    let a = Mat::from_fn(n, cols.len(), |i, j| cols[j][i]);
+    let svd = a
+        .thin_svd()
+        .map_err(|_| ReductionError::Invalid("SVD did not converge".into()))?;
+    let s = svd.S().column_vector();
+    let singular_values: Vec<f64> = (0..s.nrows()).map(|i| s[i]).collect();
+    let sum: f64 = singular_values.iter().sum();
+    let relative: Vec<f64> = singular_values.iter().map(|x| x / sum).collect();
+    let keep = relative.iter().filter(|x| **x > threshold).count().max(1);
+    let u = svd.U();
+    Ok(KeptSingular {
+        u: Mat::from_fn(n, keep, |i, j| u[(i, j)]),
+        singular_values,
+        relative,
+    })
+}
+
 /// SVD-modal basis (5.22)–(5.23): the first `r` normalized modes of each
 /// configuration weighted by ω^−a, concatenated, one SVD; the left singular
 /// vectors whose singular value exceeds `threshold` (the thesis's 1 % = 0.01)
@@ -124,40 +181,74 @@ pub fn svd_modal_basis(
     a: f64,
     threshold: f64,
 ) -> Result<SvdModal, ReductionError> {
-    let n = q0.len();
     let mut cols: Vec<Vec<f64>> = vec![];
     for p in points {
-        let v = p
-            .modes
-            .as_ref()
-            .ok_or_else(|| ReductionError::Invalid("sweep points carry no mode shapes".into()))?;
-        if v.ncols() < r {
-            return Err(ReductionError::Invalid(format!(
-                "a sweep point has {} modes, {r} needed",
-                v.ncols()
-            )));
-        }
         for j in 0..r {
             let w = (2.0 * std::f64::consts::PI * p.frequencies_hz[j].abs()).powf(-a);
-            let nrm = v.col_as_slice(j).iter().map(|x| x * x).sum::<f64>().sqrt();
-            cols.push(v.col_as_slice(j).iter().map(|x| x / nrm * w).collect());
+            cols.push(normalized_mode(p, j)?.iter().map(|x| x * w).collect());
         }
     }
-    let qs = Mat::from_fn(n, cols.len(), |i, j| cols[j][i]);
-    let svd = qs
-        .thin_svd()
-        .map_err(|_| ReductionError::Invalid("SVD did not converge".into()))?;
-    let s = svd.S().column_vector();
-    let sv: Vec<f64> = (0..s.nrows()).map(|i| s[i]).collect();
-    let sum: f64 = sv.iter().sum();
-    let relative: Vec<f64> = sv.iter().map(|x| x / sum).collect();
-    let keep = relative.iter().filter(|x| **x > threshold).count().max(1);
-    let u = svd.U();
-    let v = Mat::from_fn(n, keep, |i, j| u[(i, j)]);
+    let k = svd_keep(q0.len(), &cols, threshold)?;
     Ok(SvdModal {
-        basis: FixedBasis { q0: q0.to_vec(), v },
-        singular_values: sv,
-        relative,
+        basis: FixedBasis {
+            q0: q0.to_vec(),
+            v: k.u,
+        },
+        singular_values: k.singular_values,
+        relative: k.relative,
+    })
+}
+
+/// The result of the per-mode SVD procedure of thesis §6.3.2.
+#[derive(Clone, Debug)]
+pub struct PerModeSvd {
+    /// The basis V of (6.16).
+    pub basis: FixedBasis,
+    /// For each mode of interest, its singular values relative to their sum
+    /// (thesis Fig. 6.7) and the number of left singular vectors kept (U(j)).
+    pub per_mode: Vec<(usize, Vec<f64>, usize)>,
+    /// The singular values of the collection Q (6.21) relative to their sum
+    /// (thesis Fig. 6.8).
+    pub final_relative: Vec<f64>,
+}
+
+/// The per-mode SVD procedure of thesis §6.3.2 (steps 3–9): for each mode j in
+/// `modes` (0-based), an SVD of its normalized shapes over all configurations
+/// W(j) (6.19), keeping the left singular vectors above `threshold` of the sum
+/// (U(j)); then an SVD of Q = [U(1), …, U(r)] (6.21), keeping those above
+/// `final_threshold`. The thesis's SVD-7 and SVD-13 models use 1 % for both.
+pub fn per_mode_svd_basis(
+    q0: &[f64],
+    points: &[SweepPoint],
+    modes: &[usize],
+    threshold: f64,
+    final_threshold: f64,
+) -> Result<PerModeSvd, ReductionError> {
+    if modes.is_empty() || points.is_empty() {
+        return Err(ReductionError::Invalid(
+            "the per-mode SVD needs at least one mode and one configuration".into(),
+        ));
+    }
+    let n = q0.len();
+    let mut collected: Vec<Vec<f64>> = vec![];
+    let mut per_mode = vec![];
+    for &j in modes {
+        let w: Vec<Vec<f64>> = points
+            .iter()
+            .map(|p| normalized_mode(p, j))
+            .collect::<Result<_, _>>()?;
+        let k = svd_keep(n, &w, threshold)?;
+        per_mode.push((j, k.relative, k.u.ncols()));
+        collected.extend((0..k.u.ncols()).map(|c| k.u.col_as_slice(c).to_vec()));
+    }
+    let fin = svd_keep(n, &collected, final_threshold)?;
+    Ok(PerModeSvd {
+        basis: FixedBasis {
+            q0: q0.to_vec(),
+            v: fin.u,
+        },
+        per_mode,
+        final_relative: fin.relative,
     })
 }
 
@@ -174,6 +265,5 @@ pub fn fixed_basis_frequencies(
     let v = &basis.v;
     let mz = v.transpose() * &lin.m * v;
     let kz = v.transpose() * lin.stiffness_total() * v;
-    let _ = undamped_modes;
     Ok(generalized_symmetric(&kz, &mz, count)?.frequencies_hz())
 }

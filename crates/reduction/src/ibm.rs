@@ -16,10 +16,22 @@ pub enum SubspaceInterpolation {
     MacSorted,
 }
 
+/// The data an interpolated basis is built from.
+#[derive(Clone, Debug)]
+pub struct Knots {
+    /// The configuration coordinate at the knots.
+    pub s: Vec<f64>,
+    /// The DOFs at the knots.
+    pub qs: Vec<Vec<f64>>,
+    /// The interpolation-ready base vectors at the knots (r columns each).
+    pub w: Vec<Vec<Vec<f64>>>,
+}
+
 /// An interpolated basis q = Q(s) + V(s)η + q0, z = (s, η).
 #[derive(Clone, Debug)]
 pub struct InterpolatedBasis {
     q0: Vec<f64>,
+    knots: Knots,
     q: CubicSpline,
     v: CubicSpline,
     n_q: usize,
@@ -57,21 +69,64 @@ impl InterpolatedBasis {
             SubspaceInterpolation::Msi => modal_subspace_interpolation(vecs, mass),
             SubspaceInterpolation::MacSorted => mac_sorted(vecs),
         };
+        let w: Vec<Vec<Vec<f64>>> = w
+            .iter()
+            .map(|m| (0..r).map(|j| m.col_as_slice(j).to_vec()).collect())
+            .collect();
+        Self::from_knots(q0, s, qs.to_vec(), w)
+    }
+
+    /// From the knot data directly: the configuration coordinate values `s`,
+    /// the DOFs `qs` there and the (already interpolation-ready) base vectors
+    /// `w` there (per knot, r columns of length n_q). This is how a saved
+    /// model is restored.
+    pub fn from_knots(
+        q0: Vec<f64>,
+        s: Vec<f64>,
+        qs: Vec<Vec<f64>>,
+        w: Vec<Vec<Vec<f64>>>,
+    ) -> Result<Self, ReductionError> {
+        let n_q = q0.len();
+        let r = w.first().map_or(0, |v| v.len());
+        if qs.len() != s.len()
+            || w.len() != s.len()
+            || qs.iter().any(|q| q.len() != n_q)
+            || w.iter()
+                .any(|v| v.len() != r || v.iter().any(|c| c.len() != n_q))
+        {
+            return Err(ReductionError::Invalid(
+                "interpolated basis: inconsistent sizes of knots, configurations or base vectors"
+                    .into(),
+            ));
+        }
         let dq: Vec<Vec<f64>> = qs
             .iter()
             .map(|q| q.iter().zip(&q0).map(|(a, b)| a - b).collect())
             .collect();
-        let flat: Vec<Vec<f64>> = w
-            .iter()
-            .map(|m| (0..r).flat_map(|j| m.col_as_slice(j).to_vec()).collect())
-            .collect();
+        let flat: Vec<Vec<f64>> = w.iter().map(|m| m.concat()).collect();
         Ok(Self {
             q: CubicSpline::new(s.clone(), dq)?,
-            v: CubicSpline::new(s, flat)?,
+            v: CubicSpline::new(s.clone(), flat)?,
+            knots: Knots { s, qs, w },
             q0,
             n_q,
             r,
         })
+    }
+
+    /// The knot data (for saving): s, the DOFs and the base vectors there.
+    pub fn knots(&self) -> &Knots {
+        &self.knots
+    }
+
+    /// The offset q0.
+    pub fn q0(&self) -> &[f64] {
+        &self.q0
+    }
+
+    /// The number of interpolated base vectors r (n_z = 1 + r).
+    pub fn r(&self) -> usize {
+        self.r
     }
 
     /// V(s) and its first three derivatives (n_q × r each).
@@ -135,6 +190,21 @@ impl Basis for InterpolatedBasis {
     fn n_q(&self) -> usize {
         self.n_q
     }
+    /// (s, 0) with s the knot whose configuration is closest to q0.
+    fn z_reference(&self) -> Vec<f64> {
+        let dist = |q: &Vec<f64>| {
+            q.iter()
+                .zip(&self.q0)
+                .map(|(a, b)| (a - b).powi(2))
+                .sum::<f64>()
+        };
+        let k = (0..self.knots.s.len())
+            .min_by(|a, b| dist(&self.knots.qs[*a]).total_cmp(&dist(&self.knots.qs[*b])))
+            .unwrap_or(0);
+        let mut z = vec![0.0; 1 + self.r];
+        z[0] = self.knots.s[k];
+        z
+    }
     /// (6.23)–(6.24): q = Q + Vη + q0, G,z = [Q' + V'η, V],
     /// (G,zz ż)ż = (Q'' + V''η) ṡ² + 2 V' η̇ ṡ.
     fn eval(&self, z: &[f64], zd: &[f64], q: &mut [f64], gz: &mut Mat<f64>, conv: &mut [f64]) {
@@ -158,4 +228,58 @@ impl Basis for InterpolatedBasis {
             conv[i] = d2 * sd * sd + 2.0 * d1e * sd;
         }
     }
+}
+
+/// An interpolated basis from a sweep along the degree of freedom `s_dof`
+/// (its values are the knots s; they must increase): the configurations are
+/// the sweep's equilibria and V(s) interpolates the mode shapes `modes`
+/// (0-based indices, e.g. 1..7 for the thesis's MSI-7: mode 0 is the motion
+/// along s, which Q'(s) carries). With `mass_normalize`, MSI applies (6.26)
+/// (the sweep must keep mass matrices).
+pub fn interpolated_basis_from_sweep(
+    q0: Vec<f64>,
+    s_dof: usize,
+    points: &[flexmb_linearize::SweepPoint],
+    modes: std::ops::Range<usize>,
+    method: SubspaceInterpolation,
+    mass_normalize: bool,
+) -> Result<InterpolatedBasis, ReductionError> {
+    if s_dof >= q0.len() {
+        return Err(ReductionError::Invalid(format!(
+            "configuration coordinate index {s_dof} ≥ n_q = {}",
+            q0.len()
+        )));
+    }
+    let s: Vec<f64> = points.iter().map(|p| p.q[s_dof]).collect();
+    let qs: Vec<Vec<f64>> = points.iter().map(|p| p.q.clone()).collect();
+    let mut vecs = Vec::with_capacity(points.len());
+    let mut masses = Vec::with_capacity(points.len());
+    for p in points {
+        let v = p.modes.as_ref().ok_or_else(|| {
+            ReductionError::Invalid("sweep points carry no mode shapes (keep_vectors)".into())
+        })?;
+        if v.ncols() < modes.end {
+            return Err(ReductionError::Invalid(format!(
+                "a sweep point has {} modes, {} needed",
+                v.ncols(),
+                modes.end
+            )));
+        }
+        vecs.push(Mat::from_fn(v.nrows(), modes.len(), |i, j| {
+            v[(i, modes.start + j)]
+        }));
+        if mass_normalize {
+            masses.push(p.mass.clone().ok_or_else(|| {
+                ReductionError::Invalid("mass normalization needs the sweep's mass matrices".into())
+            })?);
+        }
+    }
+    InterpolatedBasis::new(
+        q0,
+        s,
+        &qs,
+        &vecs,
+        mass_normalize.then_some(masses.as_slice()),
+        method,
+    )
 }

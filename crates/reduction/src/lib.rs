@@ -34,14 +34,17 @@ mod basis;
 mod ibm;
 mod model;
 mod msi;
+mod saved;
 mod spline;
 
 pub use basis::{
-    fixed_basis_frequencies, modal_basis, svd_modal_basis, Basis, FixedBasis, SvdModal,
+    fixed_basis_frequencies, modal_basis, per_mode_svd_basis, svd_modal_basis, Basis, FixedBasis,
+    PerModeSvd, SvdModal,
 };
-pub use ibm::{InterpolatedBasis, SubspaceInterpolation};
-pub use model::ReducedModel;
+pub use ibm::{interpolated_basis_from_sweep, InterpolatedBasis, Knots, SubspaceInterpolation};
+pub use model::{ReducedModel, ReducedTrajectory};
 pub use msi::{largest_principal_angle, mac_sorted, modal_subspace_interpolation, orthonormalize};
+pub use saved::{dof_names, SavedBasis, SavedModel, FORMAT_VERSION};
 pub use spline::CubicSpline;
 
 /// Failures of the reduction layer.

@@ -111,6 +111,168 @@ impl ReducedModel {
     }
 }
 
+impl ReducedModel {
+    /// The basis.
+    pub fn basis(&self) -> &dyn Basis {
+        self.basis.as_ref()
+    }
+
+    /// The reduced static out-of-balance R = G,zᵀ g_s(G(z)) and its tangent
+    /// R,z = G,zᵀ(Kq + Gq − F,qᵀ f,x F,q)G,z + G,zzᵀ g_s (the static part of
+    /// (F.7)), with g_s = E,qᵀσ − F,qᵀf the unreduced out-of-balance.
+    pub fn static_tangent(
+        &mut self,
+        t: f64,
+        z: &[f64],
+    ) -> Result<(Vec<f64>, Mat<f64>), ReductionError> {
+        let nz = self.basis.n_z();
+        self.basis
+            .eval(z, &vec![0.0; nz], &mut self.q, &mut self.gz, &mut self.conv);
+        let (g, tq) = self.dy.static_tangent(t, &self.q)?;
+        let r: Vec<f64> = (0..nz)
+            .map(|k| (0..g.len()).map(|i| self.gz[(i, k)] * g[i]).sum())
+            .collect();
+        let mut kz = self.gz.transpose() * &tq * &self.gz;
+        kz += &self.basis.hessian_contraction(z, &g);
+        Ok((r, kz))
+    }
+
+    /// Static equilibrium of the reduced model at time `t` by Newton from
+    /// `z0`, with the reduced coordinates listed in `held` kept at their
+    /// values in `z0`. Converged when ‖Δz‖∞ ≤ 1e-10 (1 + ‖z‖∞); fails after 30
+    /// iterations with the remaining out-of-balance. Continuation in a load
+    /// parameter is the caller's ([`set_load_scale`](Self::set_load_scale)
+    /// in small steps, each starting from the previous equilibrium).
+    pub fn static_equilibrium(
+        &mut self,
+        t: f64,
+        z0: &[f64],
+        held: &[usize],
+    ) -> Result<Vec<f64>, ReductionError> {
+        let nz = self.basis.n_z();
+        if z0.len() != nz || held.iter().any(|h| *h >= nz) {
+            return Err(ReductionError::Invalid(format!(
+                "reduced equilibrium: {} start values and held indices {held:?} for {nz} reduced coordinates",
+                z0.len()
+            )));
+        }
+        let free: Vec<usize> = (0..nz).filter(|k| !held.contains(k)).collect();
+        let norm = |r: &[f64]| free.iter().fold(0.0f64, |m, k| m.max(r[*k].abs()));
+        let mut z = z0.to_vec();
+        let (mut r, mut kz) = self.static_tangent(t, &z)?;
+        let mut last = f64::INFINITY;
+        for _ in 0..30 {
+            let kf = Mat::from_fn(free.len(), free.len(), |a, b| kz[(free[a], free[b])]);
+            let mut dz = Mat::from_fn(free.len(), 1, |a, _| -r[free[a]]);
+            kf.partial_piv_lu().solve_in_place(dz.as_mut());
+            if (0..free.len()).any(|a| !dz[(a, 0)].is_finite()) {
+                return Err(ReductionError::Invalid(
+                    "reduced equilibrium: singular reduced stiffness (the basis cannot carry the loads, or the configuration is unstable)".into(),
+                ));
+            }
+            // damped step: halve while the configuration cannot be assembled
+            // or the out-of-balance grows a lot
+            let mut alpha = 1.0;
+            let mut err = None;
+            let (z_new, r_new, k_new) = loop {
+                let mut zt = z.clone();
+                for (a, &k) in free.iter().enumerate() {
+                    zt[k] += alpha * dz[(a, 0)];
+                }
+                match self.static_tangent(t, &zt) {
+                    Ok((rt, kt)) if norm(&rt) <= 10.0 * norm(&r) + 1e-300 => break (zt, rt, kt),
+                    Ok(_) => {}
+                    Err(e) => err = Some(e),
+                }
+                alpha *= 0.5;
+                if alpha < 1.0 / 64.0 {
+                    return Err(err.unwrap_or_else(|| {
+                        ReductionError::Invalid(
+                            "reduced equilibrium: Newton diverges (out-of-balance grows along the step)".into(),
+                        )
+                    }));
+                }
+            };
+            let step = alpha * (0..free.len()).fold(0.0f64, |m, a| m.max(dz[(a, 0)].abs()));
+            (z, r, kz) = (z_new, r_new, k_new);
+            let scale = 1.0 + z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            last = step / scale;
+            if last <= 1e-10 {
+                return Ok(z);
+            }
+        }
+        Err(ReductionError::Invalid(format!(
+            "reduced equilibrium did not converge in 30 Newton iterations (last relative step {last:.2e})"
+        )))
+    }
+
+    /// Undamped eigenfrequencies (Hz) of the reduced model at rest at z: the
+    /// rest linearization (F.7), all n_z of them, ascending.
+    pub fn frequencies_at_rest(&mut self, t: f64, z: &[f64]) -> Result<Vec<f64>, ReductionError> {
+        let (mz, kz) = self.linearize_at_rest(t, z)?;
+        Ok(flexmb_linearize::generalized_symmetric(&kz, &mz, mz.nrows())?.frequencies_hz())
+    }
+}
+
+/// A computed trajectory of a reduced model.
+#[derive(Clone, Debug)]
+pub struct ReducedTrajectory {
+    /// Output times.
+    pub t: Vec<f64>,
+    /// z at each output time.
+    pub z: Vec<Vec<f64>>,
+    /// ż at each output time.
+    pub zd: Vec<Vec<f64>>,
+    /// Integrator statistics (exact evaluation counts).
+    pub stats: flexmb_ode::Stats,
+    /// Wall time of the integration in seconds.
+    pub wall_time: f64,
+    /// True if stopped early by the observer.
+    pub stopped: bool,
+}
+
+impl ReducedModel {
+    /// Integrates the reduced equations of motion (6.15) from (t0, z0, ż0)
+    /// with an explicit integrator (the thesis's choice for reduced models);
+    /// `observer(t, z, ż)` may stop the run.
+    pub fn simulate(
+        &mut self,
+        t0: f64,
+        z0: &[f64],
+        zd0: &[f64],
+        opts: &flexmb_dynamics::SimulationOptions,
+        mut observer: impl FnMut(f64, &[f64], &[f64]) -> flexmb_dynamics::Control,
+    ) -> Result<ReducedTrajectory, ReductionError> {
+        let n = self.n_z();
+        if z0.len() != n || zd0.len() != n {
+            return Err(ReductionError::Invalid(format!(
+                "initial state of length {}/{} for {n} reduced coordinates",
+                z0.len(),
+                zd0.len()
+            )));
+        }
+        let mut y0 = z0.to_vec();
+        y0.extend_from_slice(zd0);
+        let (mut t, mut z, mut zd) = (vec![], vec![], vec![]);
+        let start = std::time::Instant::now();
+        let (stats, stopped) =
+            flexmb_dynamics::integrate_explicit(self, opts, t0, &y0, |tt: f64, y: &[f64]| {
+                t.push(tt);
+                z.push(y[..n].to_vec());
+                zd.push(y[n..].to_vec());
+                observer(tt, &y[..n], &y[n..])
+            })?;
+        Ok(ReducedTrajectory {
+            t,
+            z,
+            zd,
+            stats,
+            wall_time: start.elapsed().as_secs_f64(),
+            stopped,
+        })
+    }
+}
+
 impl OdeSystem for ReducedModel {
     fn dim(&self) -> usize {
         2 * self.basis.n_z()

@@ -1,0 +1,22 @@
+//! `cargo xtask`: regenerates the thesis benchmarks (chapters 5 and 6) with
+//! the thesis's numbers side by side, speed against error, and the CI
+//! regression of stored eigenfrequency curves. See README.md and
+//! docs/reproduce.md.
+#![warn(missing_docs)]
+
+pub mod ch5;
+pub mod ch6;
+pub mod curves;
+pub mod models;
+pub mod progress;
+pub mod regress;
+pub mod report;
+pub mod reproduce6;
+
+/// The workspace root (the parent of this crate).
+pub fn workspace_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(|p| p.to_path_buf())
+        .unwrap_or_default()
+}

@@ -1,0 +1,386 @@
+//! The models a chapter compares (unreduced and reduced) and what is measured
+//! on each: quasi-static eigenfrequency curves along a load parameter, and
+//! time responses with their cost.
+
+use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions, StaticOptions};
+use flexmb_kinematics::Kinematics;
+use flexmb_linearize::undamped_modes;
+use flexmb_model::Mechanism;
+use flexmb_reduction::{Basis, FixedBasis, InterpolatedBasis, ReducedModel};
+use std::sync::Arc;
+
+/// How a model constrains the degrees of freedom.
+#[derive(Clone)]
+pub enum ModelKind {
+    /// All degrees of freedom.
+    Unreduced,
+    /// A fixed basis (6.16).
+    Fixed(FixedBasis),
+    /// An interpolated basis (6.23).
+    Interpolated(InterpolatedBasis),
+}
+
+/// A named model of a mechanism.
+#[derive(Clone)]
+pub struct Model {
+    /// Name as in the thesis (e.g. "MSI-7").
+    pub name: String,
+    /// The (unreduced) mechanism it is evaluated on.
+    pub mech: Arc<Mechanism>,
+    /// Its constraint.
+    pub kind: ModelKind,
+}
+
+impl Model {
+    /// A model.
+    pub fn new(name: &str, mech: &Arc<Mechanism>, kind: ModelKind) -> Self {
+        Self {
+            name: name.into(),
+            mech: mech.clone(),
+            kind,
+        }
+    }
+
+    /// The reduced model, if reduced.
+    pub fn reduced(&self) -> Option<ReducedModel> {
+        let b: Box<dyn Basis> = match &self.kind {
+            ModelKind::Unreduced => return None,
+            ModelKind::Fixed(b) => Box::new(b.clone()),
+            ModelKind::Interpolated(b) => Box::new(b.clone()),
+        };
+        Some(ReducedModel::new(self.mech.clone(), b))
+    }
+
+    /// Number of coordinates integrated (n_q or n_z).
+    pub fn size(&self) -> usize {
+        match &self.kind {
+            ModelKind::Unreduced => self.mech.n_dof(),
+            ModelKind::Fixed(b) => b.n_z(),
+            ModelKind::Interpolated(b) => b.n_z(),
+        }
+    }
+}
+
+/// Displacements of one node (from its reference position) from the degrees
+/// of freedom.
+pub struct NodeProbe {
+    kin: Kinematics,
+    index: Vec<usize>,
+    at: Vec<f64>,
+}
+
+impl NodeProbe {
+    /// A probe of node `id`.
+    pub fn new(mech: &Arc<Mechanism>, id: &str) -> Result<Self, String> {
+        let node = mech
+            .node(id)
+            .ok_or_else(|| format!("no node '{id}' in {}", mech.name))?;
+        Ok(Self {
+            kin: Kinematics::new(mech.clone()),
+            index: node.position.clone(),
+            at: node.at.clone(),
+        })
+    }
+    /// The node's displacement at (q, t).
+    pub fn displacement(&mut self, q: &[f64], t: f64) -> Result<Vec<f64>, String> {
+        self.kin.solve(q, t).map_err(|e| e.to_string())?;
+        Ok(self
+            .index
+            .iter()
+            .zip(&self.at)
+            .map(|(i, a)| self.kin.x()[*i] - a)
+            .collect())
+    }
+}
+
+/// One point of a quasi-static curve.
+#[derive(Clone, Debug)]
+pub struct CurvePoint {
+    /// The load scale.
+    pub lambda: f64,
+    /// The probed node's displacement.
+    pub position: Vec<f64>,
+    /// Undamped eigenfrequencies (Hz), ascending (all of a reduced model, the
+    /// requested number of an unreduced one).
+    pub freqs: Vec<f64>,
+    /// The highest eigenfrequency of the model (Hz).
+    pub highest: f64,
+}
+
+/// The state a continuation carries: q (unreduced) or z (reduced).
+enum Solver {
+    Full(Box<Dynamics>, Vec<f64>),
+    Reduced(Box<ReducedModel>, Vec<f64>),
+}
+
+impl Solver {
+    fn new(model: &Model) -> Self {
+        match model.reduced() {
+            None => Solver::Full(Box::new(Dynamics::new(model.mech.clone())), model.mech.q0()),
+            Some(r) => {
+                let z = r.basis().z_reference();
+                Solver::Reduced(Box::new(r), z)
+            }
+        }
+    }
+    fn state(&self) -> Vec<f64> {
+        match self {
+            Solver::Full(_, q) | Solver::Reduced(_, q) => q.clone(),
+        }
+    }
+    fn set_state(&mut self, s: Vec<f64>) {
+        match self {
+            Solver::Full(_, q) | Solver::Reduced(_, q) => *q = s,
+        }
+    }
+    /// Equilibrium at load scale λ from the current state.
+    fn equilibrium(&mut self, t: f64, lambda: f64, first: bool) -> Result<(), String> {
+        match self {
+            Solver::Full(dy, q) => {
+                dy.set_load_scale(lambda);
+                let o = StaticOptions {
+                    ramp_loads: first,
+                    ..Default::default()
+                };
+                *q = dy
+                    .static_equilibrium(t, q, &o)
+                    .map_err(|e| e.to_string())?
+                    .q;
+            }
+            Solver::Reduced(r, z) => {
+                r.set_load_scale(lambda);
+                *z = r.static_equilibrium(t, z, &[]).map_err(|e| e.to_string())?;
+            }
+        }
+        Ok(())
+    }
+    /// The full DOFs of the current state.
+    fn q(&mut self) -> Vec<f64> {
+        match self {
+            Solver::Full(_, q) => q.clone(),
+            Solver::Reduced(r, z) => {
+                let z = z.clone();
+                r.full_coordinates(&z)
+            }
+        }
+    }
+    /// Eigenfrequencies at the current state (load scale as last set).
+    fn frequencies(&mut self, t: f64, count: usize) -> Result<(Vec<f64>, f64), String> {
+        match self {
+            Solver::Full(dy, q) => {
+                let lin = dy.linearize_at_rest(t, q).map_err(|e| e.to_string())?;
+                let all = undamped_modes(&lin, lin.m.nrows()).map_err(|e| e.to_string())?;
+                let f = all.frequencies_hz();
+                let highest = f.last().copied().unwrap_or(0.0);
+                Ok((f.into_iter().take(count).collect(), highest))
+            }
+            Solver::Reduced(r, z) => {
+                let z = z.clone();
+                let f = r.frequencies_at_rest(t, &z).map_err(|e| e.to_string())?;
+                let highest = f.last().copied().unwrap_or(0.0);
+                Ok((f, highest))
+            }
+        }
+    }
+}
+
+/// Continuation to load scale `to` from the solver's current equilibrium at
+/// `from`, in 1, 2, 4, … 64 substeps (halving on failure).
+fn continue_to(s: &mut Solver, t: f64, from: f64, to: f64) -> Result<(), String> {
+    let start = s.state();
+    let mut err = String::new();
+    for n in [1usize, 2, 4, 8, 16, 32, 64] {
+        s.set_state(start.clone());
+        let mut ok = true;
+        for k in 1..=n {
+            let l = from + (to - from) * k as f64 / n as f64;
+            if let Err(e) = s.equilibrium(t, l, false) {
+                err = e;
+                ok = false;
+                break;
+            }
+        }
+        if ok {
+            return Ok(());
+        }
+    }
+    s.set_state(start);
+    Err(format!(
+        "no equilibrium at load scale {to:.4} (from {from:.4}, 64 substeps): {err}"
+    ))
+}
+
+/// The quasi-static eigenfrequency curve of a model: at each load scale of
+/// `lambdas` (ascending, loads evaluated at `t`, gravity as in the scene) the
+/// static equilibrium by continuation from λ = 0 outwards, the probed node's
+/// position and the eigenfrequencies of the rest linearization ((E.6) or
+/// (F.7)). `count` limits the unreduced model's frequencies.
+pub fn quasi_static_curve(
+    model: &Model,
+    t: f64,
+    lambdas: &[f64],
+    node: &str,
+    count: usize,
+) -> Result<Vec<CurvePoint>, String> {
+    let ctx = |e: String| format!("{}: {e}", model.name);
+    let mut probe = NodeProbe::new(&model.mech, node)?;
+    let mut s = Solver::new(model);
+    s.equilibrium(t, 0.0, true).map_err(ctx)?;
+    let at_zero = s.state();
+    let mid = lambdas.partition_point(|l| *l < 0.0);
+    let mut out: Vec<Option<CurvePoint>> = vec![None; lambdas.len()];
+    let mut point = |s: &mut Solver, l: f64| -> Result<CurvePoint, String> {
+        let q = s.q();
+        let (freqs, highest) = s.frequencies(t, count)?;
+        Ok(CurvePoint {
+            lambda: l,
+            position: probe.displacement(&q, t)?,
+            freqs,
+            highest,
+        })
+    };
+    // upwards from 0, then downwards from 0
+    let mut prev = 0.0;
+    for (i, l) in lambdas.iter().enumerate().skip(mid) {
+        continue_to(&mut s, t, prev, *l).map_err(ctx)?;
+        out[i] = Some(point(&mut s, *l).map_err(ctx)?);
+        prev = *l;
+    }
+    s.set_state(at_zero);
+    prev = 0.0;
+    for i in (0..mid).rev() {
+        let l = lambdas[i];
+        continue_to(&mut s, t, prev, l).map_err(ctx)?;
+        out[i] = Some(point(&mut s, l).map_err(ctx)?);
+        prev = l;
+    }
+    Ok(out.into_iter().flatten().collect())
+}
+
+/// A time response and what it cost.
+#[derive(Clone, Debug)]
+pub struct Response {
+    /// Output times.
+    pub t: Vec<f64>,
+    /// The probed node's displacement at each output time.
+    pub position: Vec<Vec<f64>>,
+    /// The DOFs q at each output time.
+    pub q: Vec<Vec<f64>>,
+    /// The reduced coordinates z at each output time (reduced models).
+    pub z: Option<Vec<Vec<f64>>>,
+    /// Right-hand-side (or residual) evaluations.
+    pub evaluations: u64,
+    /// Accepted steps.
+    pub steps: u64,
+    /// Wall time of the integration (s).
+    pub wall_time: f64,
+    /// Integrator and tolerances, for the report.
+    pub settings: String,
+}
+
+/// Simulates a model from its static equilibrium at t0 (loads and gravity at
+/// t0), at rest. `progress(t)` is called at each output time.
+pub fn simulate(
+    model: &Model,
+    opts: &SimulationOptions,
+    node: &str,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<Response, String> {
+    let ctx = |e: String| format!("{}: {e}", model.name);
+    let t0 = opts.output_times[0];
+    let settings = format!(
+        "{} rtol {:.0e} atol {:.0e}",
+        match opts.integrator {
+            Integrator::Dopri5 => "DOPRI5 (ode45-like)",
+            Integrator::Adams => "Adams (Shampine–Gordon)",
+            Integrator::GeneralizedAlpha => "generalized-α (implicit)",
+        },
+        opts.rtol,
+        opts.atol
+    );
+    let mut probe = NodeProbe::new(&model.mech, node)?;
+    let mut s = Solver::new(model);
+    s.equilibrium(t0, 1.0, true).map_err(ctx)?;
+    let start = s.state();
+    let (t, q, z, evaluations, steps, wall_time) = match s {
+        Solver::Full(mut dy, _) => {
+            let qd0 = vec![0.0; start.len()];
+            let tr = dy
+                .simulate(t0, &start, &qd0, opts, |t, _, _| {
+                    progress(t);
+                    Control::Continue
+                })
+                .map_err(|e| ctx(e.to_string()))?;
+            (
+                tr.t,
+                tr.q,
+                None,
+                tr.stats.rhs_evals as u64,
+                tr.stats.steps_accepted as u64,
+                tr.wall_time,
+            )
+        }
+        Solver::Reduced(mut r, _) => {
+            let zd0 = vec![0.0; start.len()];
+            let tr = r
+                .simulate(t0, &start, &zd0, opts, |t, _, _| {
+                    progress(t);
+                    Control::Continue
+                })
+                .map_err(|e| ctx(e.to_string()))?;
+            let q: Vec<Vec<f64>> = tr.z.iter().map(|z| r.full_coordinates(z)).collect();
+            (
+                tr.t,
+                q,
+                Some(tr.z),
+                tr.stats.rhs_evals as u64,
+                tr.stats.steps_accepted as u64,
+                tr.wall_time,
+            )
+        }
+    };
+    let position = t
+        .iter()
+        .zip(&q)
+        .map(|(tt, qq)| probe.displacement(qq, *tt))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(ctx)?;
+    Ok(Response {
+        t,
+        position,
+        q,
+        z,
+        evaluations,
+        steps,
+        wall_time,
+        settings,
+    })
+}
+
+/// Undamped eigenfrequencies (Hz) of a model at rest at the state of output
+/// `i` of its response ((E.6), reduced (F.7)), the first `count`.
+pub fn frequencies_along(
+    model: &Model,
+    r: &Response,
+    i: usize,
+    count: usize,
+) -> Result<Vec<f64>, String> {
+    let t = r.t[i];
+    match (model.reduced(), &r.z) {
+        (Some(mut red), Some(z)) => {
+            let f = red
+                .frequencies_at_rest(t, &z[i])
+                .map_err(|e| e.to_string())?;
+            Ok(f.into_iter().take(count).collect())
+        }
+        _ => {
+            let mut dy = Dynamics::new(model.mech.clone());
+            let lin = dy
+                .linearize_at_rest(t, &r.q[i])
+                .map_err(|e| e.to_string())?;
+            Ok(undamped_modes(&lin, count)
+                .map_err(|e| e.to_string())?
+                .frequencies_hz())
+        }
+    }
+}
