@@ -30,14 +30,29 @@ fn steel() -> Material {
     }
 }
 
-/// A fresh work directory under the system temp directory.
-fn work_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("flexmb-se-e2e-{}-{name}", std::process::id()));
-    if d.exists() {
-        std::fs::remove_dir_all(&d).unwrap();
+/// A fresh work directory under the system temp directory, removed when the
+/// test passes and kept (for inspection) when it fails.
+struct WorkDir(PathBuf);
+
+impl WorkDir {
+    fn new(name: &str) -> Self {
+        let d = std::env::temp_dir().join(format!("flexmb-se-e2e-{}-{name}", std::process::id()));
+        if d.exists() {
+            std::fs::remove_dir_all(&d).unwrap();
+        }
+        std::fs::create_dir_all(&d).unwrap();
+        WorkDir(d)
     }
-    std::fs::create_dir_all(&d).unwrap();
-    d
+}
+
+impl Drop for WorkDir {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            eprintln!("work files kept in {}", self.0.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
 }
 
 /// Runs `program args` in `dir`; fails the test if the program is not on PATH
@@ -198,7 +213,8 @@ fn rigid_body_error(a: &RigidBodyProperties, r: &RigidBodyProperties) -> f64 {
 #[test]
 fn gmsh_hex20_calculix_matches_the_builtin_fe_on_the_same_grid() {
     let n = [10, 2, 2];
-    let dir = work_dir("hex20");
+    let work = WorkDir::new("hex20");
+    let dir = work.0.as_path();
     let geo = format!(
         "// steel bar {L} x {B} x {B} m, {nx} x {ny} x {nz} hexahedra\n\
          Point(1) = {{0, {y0}, {y0}, 1}};\n\
@@ -212,13 +228,13 @@ fn gmsh_hex20_calculix_matches_the_builtin_fe_on_the_same_grid() {
         ny = n[1],
         nz = n[2]
     );
-    let mesh = gmsh(&dir, "bar_hex", &geo);
+    let mesh = gmsh(dir, "bar_hex", &geo);
     let text = std::fs::read_to_string(dir.join(&mesh)).unwrap();
     assert!(
         text.contains("type=C3D20"),
         "gmsh should write C3D20 elements"
     );
-    let model = calculix(&dir, "hex", &mesh);
+    let model = calculix(dir, "hex", &mesh);
     let s = settings(true, 4);
     let reference = builtin(n, &s);
     assert_eq!(
@@ -291,7 +307,7 @@ fn gmsh_hex20_calculix_matches_the_builtin_fe_on_the_same_grid() {
     );
     let spec = Spec::from_ron(&spec_text, "bar.spec.ron").unwrap();
     assert_eq!(spec.settings, s);
-    let out = build_from_spec(&spec, &dir).unwrap();
+    let out = build_from_spec(&spec, dir).unwrap();
     assert_eq!(out.result.data.s_bar, se.data.s_bar);
     assert_eq!(out.result.data.m_bar, se.data.m_bar);
     assert!(dir.join("bar.se.ron").exists());
@@ -371,7 +387,8 @@ fn rigid_body_of_fe_mass(model: &FeModel) -> RigidBodyProperties {
 /// mesher, a different discretization from the built-in hexahedra.
 #[test]
 fn gmsh_tet10_calculix_matches_the_builtin_fe_within_the_mesh_difference() {
-    let dir = work_dir("tet10");
+    let work = WorkDir::new("tet10");
+    let dir = work.0.as_path();
     let s = settings(false, 0);
     let mut tet = Vec::new();
     let mut forbidden = Vec::new();
@@ -384,13 +401,13 @@ fn gmsh_tet10_calculix_matches_the_builtin_fe_within_the_mesh_difference() {
              Physical Volume(\"BAR\") = {{1}};\n",
             y0 = -0.5 * B
         );
-        let mesh = gmsh(&dir, &format!("bar_tet{k}"), &geo);
+        let mesh = gmsh(dir, &format!("bar_tet{k}"), &geo);
         let text = std::fs::read_to_string(dir.join(&mesh)).unwrap();
         assert!(
             text.contains("type=C3D10"),
             "gmsh should write C3D10 elements"
         );
-        let model = calculix(&dir, &format!("tet{k}"), &mesh);
+        let model = calculix(dir, &format!("tet{k}"), &mesh);
         let se = build(&model, &s).unwrap();
         let d_fe = rigid_body_error(&rigid_body_of_fe_mass(&model), &analytic_rigid_body());
         let rb = RigidBodyProperties::from_m_bar(&se.data.m_bar_matrix(), se.data.l0);
