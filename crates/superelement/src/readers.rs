@@ -6,7 +6,8 @@
 //! * CalculiX: `JOB.sti` and `JOB.mas` (`row col value`, 1-based, one triangle
 //!   with the diagonal), `JOB.dof` (one `node.dir` per equation, dir 1–3 = ux,
 //!   uy, uz; parsed as text because "1.10" is not "1.1"), and the node
-//!   coordinates (and solid elements, for the mesh volume) from the `.inp` mesh.
+//!   coordinates (and solid elements, for the mesh volume) from the `.inp` mesh
+//!   or the deck that `*INCLUDE`s it (as written by `gmsh -format inp`).
 //!   DOFs removed by *BOUNDARY / *EQUATION are absent from all three files.
 
 use crate::model::{DofMap, FeModel};
@@ -14,7 +15,7 @@ use crate::Error;
 use faer::sparse::{SparseColMat, SparseColMatRef};
 use std::collections::HashMap;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 fn read(path: &Path) -> Result<String, Error> {
     std::fs::read_to_string(path).map_err(|e| Error::io(path, e))
@@ -342,6 +343,9 @@ pub struct InpMesh {
     pub elements: Vec<(String, Vec<u64>)>,
     /// Node sets (*NSET) by upper-case name.
     pub nsets: HashMap<String, Vec<u64>>,
+    /// The files read: the `.inp` and the files it `*INCLUDE`s (empty when
+    /// parsed from text).
+    pub files: Vec<PathBuf>,
 }
 
 impl InpMesh {
@@ -398,216 +402,322 @@ impl InpMesh {
     }
 }
 
-/// Parses the *NODE, *ELEMENT (solid types C3D*) and *NSET blocks of an `.inp`
-/// file as written by `gmsh -format inp` or CalculiX.
-pub fn parse_inp(text: &str, file: &str) -> Result<InpMesh, Error> {
-    #[derive(PartialEq)]
-    enum Block {
-        None,
-        Node,
-        Element(String),
-        Nset(String, bool),
+/// How deep `*INCLUDE`s may nest (deeper is taken for a cycle).
+const MAX_INCLUDE_DEPTH: usize = 16;
+
+#[derive(PartialEq)]
+enum Block {
+    None,
+    Node,
+    Element(String),
+    Nset(String, bool),
+}
+
+/// The state of the `.inp` parser, kept across `*INCLUDE`d files (an include
+/// is textual: a block may continue into or out of the included file).
+struct InpParser {
+    mesh: InpMesh,
+    block: Block,
+    pending: Vec<u64>,
+    pending_at: (String, usize),
+}
+
+/// Nodes per solid element type (C3D4, C3D10, C3D8, C3D20, C3D6, C3D15 and
+/// their variants such as C3D10T, C3D20R); `None` for other types.
+fn solid_element_nodes(ty: &str) -> Option<usize> {
+    // longest prefixes first: C3D10 before C3D1, C3D20 before C3D2
+    [
+        ("C3D10", 10),
+        ("C3D15", 15),
+        ("C3D20", 20),
+        ("C3D4", 4),
+        ("C3D6", 6),
+        ("C3D8", 8),
+    ]
+    .iter()
+    .find(|(p, _)| ty.starts_with(p))
+    .map(|&(_, n)| n)
+}
+
+impl InpParser {
+    fn new() -> Self {
+        Self {
+            mesh: InpMesh::default(),
+            block: Block::None,
+            pending: Vec::new(),
+            pending_at: (String::new(), 0),
+        }
     }
-    let mut mesh = InpMesh::default();
-    let mut block = Block::None;
-    let mut pending: Vec<u64> = Vec::new();
-    let mut pending_line = 0;
-    for (ln, line) in text.lines().enumerate() {
-        let t = line.trim();
-        if t.is_empty() || t.starts_with("**") {
-            continue;
+
+    fn check_no_pending(&self, what: &str) -> Result<(), Error> {
+        if self.pending.is_empty() {
+            Ok(())
+        } else {
+            Err(Error::parse(&self.pending_at.0, self.pending_at.1, what))
         }
-        if t.starts_with('*') {
-            if !pending.is_empty() {
-                return Err(Error::parse(
-                    file,
-                    pending_line,
-                    "element definition continues past the block",
-                ));
+    }
+
+    /// Parses `text` (from `file`); `dir` is the directory `*INCLUDE` paths are
+    /// relative to, `None` when the text did not come from a file (an include
+    /// is then an error).
+    fn feed(
+        &mut self,
+        text: &str,
+        file: &str,
+        dir: Option<&Path>,
+        depth: usize,
+    ) -> Result<(), Error> {
+        for (ln, line) in text.lines().enumerate() {
+            let t = line.trim();
+            if t.is_empty() || t.starts_with("**") {
+                continue;
             }
-            let kw: Vec<String> = t.split(',').map(|s| s.trim().to_string()).collect();
-            let name = kw[0].to_ascii_uppercase();
-            let param = |key: &str| {
-                kw[1..].iter().find_map(|p| {
-                    let (k, v) = p.split_once('=')?;
-                    (k.trim().eq_ignore_ascii_case(key)).then(|| v.trim().to_string())
-                })
-            };
-            block = match name.as_str() {
-                "*NODE" => Block::Node,
-                "*ELEMENT" => {
-                    Block::Element(param("TYPE").unwrap_or_default().to_ascii_uppercase())
-                }
-                "*NSET" => {
-                    let gen = kw[1..].iter().any(|p| p.eq_ignore_ascii_case("GENERATE"));
-                    Block::Nset(param("NSET").unwrap_or_default().to_ascii_uppercase(), gen)
-                }
-                _ => Block::None,
-            };
-            continue;
-        }
-        let f: Vec<&str> = t
-            .split(',')
-            .map(|s| s.trim())
-            .filter(|s| !s.is_empty())
-            .collect();
-        match &block {
-            Block::None => {}
-            Block::Node => {
-                if f.len() < 3 {
-                    return Err(Error::parse(
-                        file,
-                        ln + 1,
-                        format!("expected 'label, x, y[, z]', got '{t}'"),
-                    ));
-                }
-                let id: u64 = f[0].parse().map_err(|_| {
-                    Error::parse(file, ln + 1, format!("bad node label '{}'", f[0]))
-                })?;
-                let mut x = [0.0; 3];
-                for d in 0..(f.len() - 1).min(3) {
-                    x[d] = parse_f64(f[1 + d]).ok_or_else(|| {
-                        Error::parse(file, ln + 1, format!("bad coordinate '{}'", f[1 + d]))
+            if t.starts_with('*') {
+                let kw: Vec<String> = t.split(',').map(|s| s.trim().to_string()).collect();
+                let name = kw[0].to_ascii_uppercase();
+                let param = |key: &str| {
+                    kw[1..].iter().find_map(|p| {
+                        let (k, v) = p.split_once('=')?;
+                        (k.trim().eq_ignore_ascii_case(key))
+                            .then(|| v.trim().trim_matches('"').to_string())
+                    })
+                };
+                if name == "*INCLUDE" {
+                    let input = param("INPUT").ok_or_else(|| {
+                        Error::parse(file, ln + 1, format!("'{t}' has no INPUT=file"))
                     })?;
+                    self.include(&input, file, ln + 1, dir, depth)?;
+                    continue;
                 }
-                mesh.ids.push(id);
-                mesh.coords.push(x);
+                self.check_no_pending("element definition continues past the block")?;
+                self.block = match name.as_str() {
+                    "*NODE" => Block::Node,
+                    "*ELEMENT" => {
+                        Block::Element(param("TYPE").unwrap_or_default().to_ascii_uppercase())
+                    }
+                    "*NSET" => {
+                        let gen = kw[1..].iter().any(|p| p.eq_ignore_ascii_case("GENERATE"));
+                        Block::Nset(param("NSET").unwrap_or_default().to_ascii_uppercase(), gen)
+                    }
+                    _ => Block::None,
+                };
+                continue;
             }
-            Block::Element(ty) => {
-                if pending.is_empty() {
-                    pending_line = ln + 1;
+            let f: Vec<&str> = t
+                .split(',')
+                .map(|s| s.trim())
+                .filter(|s| !s.is_empty())
+                .collect();
+            match &self.block {
+                Block::None => {}
+                Block::Node => {
+                    if f.len() < 3 {
+                        return Err(Error::parse(
+                            file,
+                            ln + 1,
+                            format!("expected 'label, x, y[, z]', got '{t}'"),
+                        ));
+                    }
+                    let id: u64 = f[0].parse().map_err(|_| {
+                        Error::parse(file, ln + 1, format!("bad node label '{}'", f[0]))
+                    })?;
+                    let mut x = [0.0; 3];
+                    for d in 0..(f.len() - 1).min(3) {
+                        x[d] = parse_f64(f[1 + d]).ok_or_else(|| {
+                            Error::parse(file, ln + 1, format!("bad coordinate '{}'", f[1 + d]))
+                        })?;
+                    }
+                    self.mesh.ids.push(id);
+                    self.mesh.coords.push(x);
                 }
-                for s in &f {
-                    pending.push(s.parse().map_err(|_| {
-                        Error::parse(file, ln + 1, format!("bad element entry '{s}'"))
-                    })?);
-                }
-                let need = match ty.as_str() {
-                    t if t.starts_with("C3D4") => 5,
-                    t if t.starts_with("C3D10") => 11,
-                    t if t.starts_with("C3D8") => 9,
-                    t if t.starts_with("C3D20") => 21,
-                    t if t.starts_with("C3D6") => 7,
-                    t if t.starts_with("C3D15") => 16,
-                    _ => {
-                        pending.clear();
+                Block::Element(ty) => {
+                    // other element types (gmsh writes lines and faces too
+                    // when no physical groups are defined) are skipped
+                    let Some(n) = solid_element_nodes(ty) else {
+                        continue;
+                    };
+                    if self.pending.is_empty() {
+                        self.pending_at = (file.to_string(), ln + 1);
+                    }
+                    for s in &f {
+                        self.pending.push(s.parse().map_err(|_| {
+                            Error::parse(file, ln + 1, format!("bad element entry '{s}'"))
+                        })?);
+                    }
+                    // lines break with or without a trailing comma
+                    if self.pending.len() < n + 1 {
                         continue;
                     }
-                };
-                if t.ends_with(',') && pending.len() < need {
-                    continue;
-                }
-                if pending.len() < need {
-                    // lines may also break without a trailing comma
-                    continue;
-                }
-                if pending.len() != need {
-                    return Err(Error::parse(
-                        file,
-                        pending_line,
-                        format!(
-                            "a {ty} element needs {} nodes, got {}",
-                            need - 1,
-                            pending.len() - 1
-                        ),
-                    ));
-                }
-                mesh.elements.push((ty.clone(), pending[1..].to_vec()));
-                pending.clear();
-            }
-            Block::Nset(name, generate) => {
-                let set = mesh.nsets.entry(name.clone()).or_default();
-                let nums: Vec<u64> = f
-                    .iter()
-                    .map(|s| {
-                        s.parse().map_err(|_| {
-                            Error::parse(file, ln + 1, format!("bad node label '{s}'"))
-                        })
-                    })
-                    .collect::<Result<_, _>>()?;
-                if *generate {
-                    let (a, b, st) = (
-                        nums[0],
-                        *nums.get(1).unwrap_or(&nums[0]),
-                        *nums.get(2).unwrap_or(&1),
-                    );
-                    let mut k = a;
-                    while k <= b {
-                        set.push(k);
-                        k += st.max(1);
+                    if self.pending.len() != n + 1 {
+                        return Err(Error::parse(
+                            &self.pending_at.0,
+                            self.pending_at.1,
+                            format!(
+                                "a {ty} element needs {n} nodes, got {}",
+                                self.pending.len() - 1
+                            ),
+                        ));
                     }
-                } else {
-                    set.extend(nums);
+                    let nodes = self.pending[1..].to_vec();
+                    self.mesh.elements.push((ty.clone(), nodes));
+                    self.pending.clear();
+                }
+                Block::Nset(name, generate) => {
+                    let nums: Vec<u64> = f
+                        .iter()
+                        .map(|s| {
+                            s.parse().map_err(|_| {
+                                Error::parse(file, ln + 1, format!("bad node label '{s}'"))
+                            })
+                        })
+                        .collect::<Result<_, _>>()?;
+                    let set = self.mesh.nsets.entry(name.clone()).or_default();
+                    if *generate {
+                        let (a, b, st) = (
+                            nums[0],
+                            *nums.get(1).unwrap_or(&nums[0]),
+                            *nums.get(2).unwrap_or(&1),
+                        );
+                        let mut k = a;
+                        while k <= b {
+                            set.push(k);
+                            k += st.max(1);
+                        }
+                    } else {
+                        set.extend(nums);
+                    }
                 }
             }
         }
+        Ok(())
     }
-    if !pending.is_empty() {
-        return Err(Error::parse(
-            file,
-            pending_line,
-            "incomplete element definition at the end of the file",
-        ));
+
+    fn include(
+        &mut self,
+        input: &str,
+        file: &str,
+        line: usize,
+        dir: Option<&Path>,
+        depth: usize,
+    ) -> Result<(), Error> {
+        let Some(dir) = dir else {
+            return Err(Error::parse(
+                file,
+                line,
+                format!(
+                    "*INCLUDE, INPUT={input}: includes are followed only when reading a file \
+                     (readers::read_inp), not when parsing text"
+                ),
+            ));
+        };
+        if depth >= MAX_INCLUDE_DEPTH {
+            return Err(Error::parse(
+                file,
+                line,
+                format!(
+                    "*INCLUDE, INPUT={input}: includes nested more than {MAX_INCLUDE_DEPTH} deep \
+                     (a file including itself?)"
+                ),
+            ));
+        }
+        let path = dir.join(input);
+        let text = read(&path)?;
+        self.mesh.files.push(path.clone());
+        let sub_dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+        self.feed(&text, &fname(&path), Some(&sub_dir), depth + 1)
     }
-    if mesh.ids.is_empty() {
-        return Err(Error::parse(file, 0, "no *NODE block"));
+
+    fn finish(self, file: &str) -> Result<InpMesh, Error> {
+        self.check_no_pending("incomplete element definition at the end of the file")?;
+        if self.mesh.ids.is_empty() {
+            return Err(Error::parse(file, 0, "no *NODE block"));
+        }
+        Ok(self.mesh)
     }
-    Ok(mesh)
+}
+
+/// Parses the *NODE, *ELEMENT (solid types C3D*) and *NSET blocks of `.inp`
+/// text as written by `gmsh -format inp` or CalculiX. Other keywords and
+/// element types are skipped; an `*INCLUDE` is an error here (text has no
+/// directory to resolve it against, see [`read_inp`]).
+pub fn parse_inp(text: &str, file: &str) -> Result<InpMesh, Error> {
+    let mut p = InpParser::new();
+    p.feed(text, file, None, 0)?;
+    p.finish(file)
+}
+
+/// Reads an `.inp` file like [`parse_inp`], following `*INCLUDE, INPUT=...`
+/// (relative paths are relative to the including file's directory; `ccx` run
+/// in the deck's directory resolves them the same way). [`InpMesh::files`]
+/// lists the file and everything it includes.
+pub fn read_inp(path: &Path) -> Result<InpMesh, Error> {
+    let text = read(path)?;
+    let file = fname(path);
+    let mut p = InpParser::new();
+    p.mesh.files.push(path.to_path_buf());
+    let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    p.feed(&text, &file, Some(&dir), 0)?;
+    p.finish(&file)
 }
 
 /// Builds a model from CalculiX exports: `JOB.sti`, `JOB.mas`, `JOB.dof` and
-/// the `.inp` mesh (`inp`, default `JOB.inp`). Returns the model and the mesh.
+/// the `.inp` mesh (`inp`, default `JOB.inp`, read with [`read_inp`], so a
+/// deck that `*INCLUDE`s the gmsh mesh works). Returns the model and the mesh.
 pub fn read_calculix(job: &Path, inp: Option<&Path>) -> Result<(FeModel, InpMesh), Error> {
     let with = |ext: &str| job.with_extension(ext);
     let (sti, mas, dof) = (with("sti"), with("mas"), with("dof"));
     let inp_path = inp.map(|p| p.to_path_buf()).unwrap_or_else(|| with("inp"));
-    calculix_from_text(
-        &read(&sti)?,
-        &fname(&sti),
-        &read(&mas)?,
-        &fname(&mas),
-        &read(&dof)?,
-        &fname(&dof),
-        &read(&inp_path)?,
-        &fname(&inp_path),
+    let mesh = read_inp(&inp_path)?;
+    calculix_from_mesh(
+        [
+            (&read(&sti)?, &fname(&sti)),
+            (&read(&mas)?, &fname(&mas)),
+            (&read(&dof)?, &fname(&dof)),
+        ],
+        mesh,
         &job.file_name()
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default(),
     )
 }
 
-#[allow(clippy::too_many_arguments)]
-fn calculix_from_text(
-    sti: &str,
-    sti_name: &str,
-    mas: &str,
-    mas_name: &str,
-    dof: &str,
-    dof_name: &str,
-    inp: &str,
-    inp_name: &str,
+/// The model from `.sti`, `.mas` and `.dof` (text, file name) and the mesh.
+/// Nodes that are in no solid element and have no equation (geometry points,
+/// nodes of other element types) are left out, so that a geometric interface
+/// selection does not pick them up; nodes of solid elements without equations
+/// stay (their DOFs were removed by *BOUNDARY / *EQUATION).
+fn calculix_from_mesh(
+    [(sti, sti_name), (mas, mas_name), (dof, dof_name)]: [(&str, &str); 3],
+    mesh: InpMesh,
     name: &str,
 ) -> Result<(FeModel, InpMesh), Error> {
-    let mesh = parse_inp(inp, inp_name)?;
     let dofs = parse_calculix_dof(dof, dof_name)?;
     let n = dofs.len();
     let k = parse_calculix_matrix(sti, sti_name, n)?;
     let m = parse_calculix_matrix(mas, mas_name, n)?;
-    let model = model_from_parts(
-        name,
-        mesh.ids.clone(),
-        mesh.coords.clone(),
-        &dofs,
-        k,
-        m,
-        dof_name,
-    )?;
-    let mut model = model;
+    let (ids, coords) = if mesh.elements.is_empty() {
+        (mesh.ids.clone(), mesh.coords.clone())
+    } else {
+        let used: std::collections::HashSet<u64> = mesh
+            .elements
+            .iter()
+            .flat_map(|(_, nodes)| nodes.iter().copied())
+            .chain(dofs.iter().map(|&(node, _)| node))
+            .collect();
+        mesh.ids
+            .iter()
+            .zip(&mesh.coords)
+            .filter(|(id, _)| used.contains(id))
+            .map(|(&id, &c)| (id, c))
+            .unzip()
+    };
+    let mut model = model_from_parts(name, ids, coords, &dofs, k, m, dof_name)?;
     model.volume = mesh.volume();
     Ok((model, mesh))
 }
 
-/// Parses a CalculiX export set given as text (the same as [`read_calculix`]).
+/// Parses a CalculiX export set given as text (the same as [`read_calculix`],
+/// but the `.inp` text may not `*INCLUDE` other files).
 pub fn parse_calculix(
     sti: &str,
     mas: &str,
@@ -615,15 +725,14 @@ pub fn parse_calculix(
     inp: &str,
     name: &str,
 ) -> Result<(FeModel, InpMesh), Error> {
-    calculix_from_text(
-        sti,
-        &format!("{name}.sti"),
-        mas,
-        &format!("{name}.mas"),
-        dof,
-        &format!("{name}.dof"),
-        inp,
-        &format!("{name}.inp"),
+    let mesh = parse_inp(inp, &format!("{name}.inp"))?;
+    calculix_from_mesh(
+        [
+            (sti, &format!("{name}.sti")),
+            (mas, &format!("{name}.mas")),
+            (dof, &format!("{name}.dof")),
+        ],
+        mesh,
         name,
     )
 }

@@ -122,13 +122,13 @@ pub fn load_model(spec: &Spec, base_dir: &Path) -> Result<(FeModel, Vec<PathBuf>
         ModelSource::CalculiX { job, inp } => {
             let job = base_dir.join(job);
             let inp = inp.as_ref().map(|p| base_dir.join(p));
-            let (mut model, _) = read_calculix(&job, inp.as_deref())?;
+            let (mut model, mesh) = read_calculix(&job, inp.as_deref())?;
             model.name = spec.name.clone();
-            let inp_path = inp.unwrap_or_else(|| job.with_extension("inp"));
+            // the .inp and everything it *INCLUDEs
             let files = ["sti", "mas", "dof"]
                 .iter()
                 .map(|e| job.with_extension(e))
-                .chain([inp_path])
+                .chain(mesh.files)
                 .collect();
             (model, files)
         }

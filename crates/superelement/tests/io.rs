@@ -4,8 +4,8 @@
 use faer::sparse::{SparseColMat, Triplet};
 use flexmb_element::{Material, Side};
 use flexmb_superelement::readers::{
-    parse_calculix, parse_calculix_dof, parse_matrix_market, read_matrix_market_model,
-    write_matrix_market, write_nodes,
+    parse_calculix, parse_calculix_dof, parse_inp, parse_matrix_market, read_calculix, read_inp,
+    read_matrix_market_model, write_matrix_market, write_nodes,
 };
 use flexmb_superelement::solid::{Block, Mesh};
 use flexmb_superelement::spec::read_ron;
@@ -349,5 +349,145 @@ fn bad_input_catalogue() {
     assert!(
         e.contains("job.sti:1") && e.contains("bad value 'x'"),
         "{e}"
+    );
+}
+
+/// The `.inp` reader on what gmsh and a CalculiX deck look like: the deck
+/// `*INCLUDE`s the mesh (relative to the including file, nested), C3D20 lines
+/// wrapped after 16 entries with a trailing comma, line and face elements
+/// (written by gmsh without physical groups) skipped, a node in no solid
+/// element and without equations left out of the model. Includes in text, a
+/// missing INPUT=, a missing file and an include cycle give errors.
+#[test]
+fn inp_includes_and_gmsh_layout() {
+    let dir = tmp("inp");
+    std::fs::create_dir_all(dir.join("mesh")).unwrap();
+    // a unit cube as one C3D20 (gmsh layout), node 99 a stray geometry point
+    let corners = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ];
+    let edges = [
+        (0, 1),
+        (1, 2),
+        (2, 3),
+        (3, 0),
+        (4, 5),
+        (5, 6),
+        (6, 7),
+        (7, 4),
+        (0, 4),
+        (1, 5),
+        (2, 6),
+        (3, 7),
+    ];
+    let mut nodes = String::from("*Heading\n mesh.inp\n*NODE\n");
+    let mut c: Vec<[f64; 3]> = corners.to_vec();
+    for &(a, b) in &edges {
+        c.push(std::array::from_fn(|d| {
+            0.5 * (corners[a][d] + corners[b][d])
+        }));
+    }
+    for (i, x) in c.iter().enumerate() {
+        nodes.push_str(&format!("{}, {}, {}, {}\n", i + 1, x[0], x[1], x[2]));
+    }
+    nodes.push_str("99, 5, 5, 5\n");
+    let mesh = format!(
+        "{nodes}******* E L E M E N T S *************\n\
+         *ELEMENT, type=T3D3, ELSET=Line1\n1, 1, 2, 9\n\
+         *ELEMENT, type=CPS8, ELSET=Surface1\n2, 1, 2, 3, 4, 9, 10, 11, 12\n\
+         *ELEMENT, type=C3D20, ELSET=Volume1\n\
+         3, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, \n16, 17, 18, 19, 20\n\
+         *ELSET,ELSET=BAR\n3, \n"
+    );
+    std::fs::write(dir.join("mesh/part.inp"), mesh).unwrap();
+    std::fs::write(dir.join("mesh/all.inp"), "*INCLUDE, INPUT=part.inp\n").unwrap();
+    let deck = "*INCLUDE, INPUT=mesh/all.inp\n*MATERIAL, NAME=STEEL\n*ELASTIC\n2.1e11, 0.3\n\
+                *SOLID SECTION, ELSET=BAR, MATERIAL=STEEL\n*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n*END STEP\n";
+    std::fs::write(dir.join("job.inp"), deck).unwrap();
+    // K = M = identity over the 60 equations of nodes 1..20
+    let mut dof = String::new();
+    let mut diag = String::new();
+    for n in 1..=20 {
+        for d in 1..=3 {
+            dof.push_str(&format!("{n}.{d}\n"));
+            let e = 3 * (n - 1) + d;
+            diag.push_str(&format!("{e} {e} 1.0\n"));
+        }
+    }
+    for ext in ["sti", "mas"] {
+        std::fs::write(dir.join(format!("job.{ext}")), &diag).unwrap();
+    }
+    std::fs::write(dir.join("job.dof"), &dof).unwrap();
+    let (model, mesh) = read_calculix(&dir.join("job"), None).unwrap();
+    assert_eq!(
+        mesh.files,
+        vec![
+            dir.join("job.inp"),
+            dir.join("mesh/all.inp"),
+            dir.join("mesh/part.inp")
+        ]
+    );
+    assert_eq!(mesh.ids.len(), 21);
+    assert_eq!(mesh.elements.len(), 1, "only the solid element");
+    assert_eq!(mesh.elements[0].0, "C3D20");
+    assert_eq!(mesh.elements[0].1, (1..=20).collect::<Vec<u64>>());
+    assert_eq!(model.n_nodes(), 20, "the stray node 99 is left out");
+    assert!(model.node_index(99).is_none());
+    assert_eq!(model.n_eq(), 60);
+    assert!((model.volume.unwrap() - 1.0).abs() < 1e-15);
+    // the spec path records every file read, the included ones too
+    let (_, files) = flexmb_superelement::spec::load_model(
+        &Spec {
+            name: "cube".into(),
+            model: ModelSource::CalculiX {
+                job: "job".into(),
+                inp: None,
+            },
+            settings: BuildSettings::new(
+                [0.0; 3],
+                [1.0, 0.0, 0.0],
+                NodeSelection::Ids(vec![1]),
+                NodeSelection::Ids(vec![2]),
+            ),
+            output: "cube.se.ron".into(),
+            m_bar_matrix_market: None,
+        },
+        &dir,
+    )
+    .unwrap();
+    assert!(files.contains(&dir.join("mesh/part.inp")) && files.len() == 6);
+    // errors
+    expect_err(read_inp(&dir.join("nowhere.inp")), &["nowhere.inp"]);
+    expect_err(
+        parse_inp("*INCLUDE, INPUT=mesh.inp\n", "deck.inp"),
+        &["deck.inp:1", "only when reading a file"],
+    );
+    std::fs::write(dir.join("noinput.inp"), "*NODE\n1, 0, 0, 0\n*INCLUDE\n").unwrap();
+    expect_err(
+        read_inp(&dir.join("noinput.inp")),
+        &["noinput.inp:3", "no INPUT="],
+    );
+    std::fs::write(dir.join("missing.inp"), "*INCLUDE, INPUT=gone.inp\n").unwrap();
+    expect_err(read_inp(&dir.join("missing.inp")), &["gone.inp"]);
+    std::fs::write(dir.join("cycle.inp"), "*INCLUDE, INPUT=cycle.inp\n").unwrap();
+    expect_err(
+        read_inp(&dir.join("cycle.inp")),
+        &["cycle.inp:1", "nested more than 16 deep"],
+    );
+    std::fs::write(
+        dir.join("short.inp"),
+        "*NODE\n1, 0, 0, 0\n*ELEMENT, TYPE=C3D10\n1, 1, 2, 3,\n*NSET, NSET=A\n1\n",
+    )
+    .unwrap();
+    expect_err(
+        read_inp(&dir.join("short.inp")),
+        &["short.inp:4", "continues past the block"],
     );
 }
