@@ -388,7 +388,11 @@ fn write_outputs(
         t.row(vec![
             r.name.clone(),
             r.model_size.to_string(),
-            format!("{te:.0}"),
+            if te.is_finite() {
+                format!("{te:.0}")
+            } else {
+                "–".into()
+            },
             r.response.evaluations.to_string(),
             sig(r.response.evaluations as f64 / te),
             sig(th),
