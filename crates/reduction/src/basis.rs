@@ -21,6 +21,17 @@ pub trait Basis: Send {
     fn hessian_contraction(&self, _z: &[f64], _r: &[f64]) -> Mat<f64> {
         Mat::zeros(self.n_z(), self.n_z())
     }
+    /// The matrix Σⱼ vⱼ ∂²G/∂zⱼ∂z_k (n_q × n_z, column k): the derivative of
+    /// G,z v with respect to z. With v = ż it is G,zz ż of (F.5c)/(F.5f).
+    /// Zero for a fixed basis.
+    fn second_derivative_matrix(&self, _z: &[f64], _v: &[f64]) -> Mat<f64> {
+        Mat::zeros(self.n_q(), self.n_z())
+    }
+    /// The matrix ∂/∂z_k [(G,zz ż)ż] (n_q × n_z), i.e. (G,zzz ż)ż of (F.5f).
+    /// Zero for a fixed basis.
+    fn third_derivative_matrix(&self, _z: &[f64], _zd: &[f64]) -> Mat<f64> {
+        Mat::zeros(self.n_q(), self.n_z())
+    }
     /// The reduced coordinates of the configuration the basis was built
     /// around (where G(z) is closest to q0): zero for a fixed basis.
     fn z_reference(&self) -> Vec<f64> {

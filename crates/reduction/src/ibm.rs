@@ -190,6 +190,47 @@ impl Basis for InterpolatedBasis {
     fn n_q(&self) -> usize {
         self.n_q
     }
+    /// (F.6): column s = v_s (Q″ + V″η) + V′ v_η, column η_j = v_s V′_j.
+    fn second_derivative_matrix(&self, z: &[f64], v: &[f64]) -> Mat<f64> {
+        let (s, eta) = (z[0], &z[1..]);
+        let mut wq = self.q.work();
+        self.q.eval(s, &mut wq);
+        let vv = self.v_and_derivatives(s);
+        Mat::from_fn(self.n_q, 1 + self.r, |i, k| {
+            if k == 0 {
+                let mut gss = wq[2][i];
+                let mut a = 0.0;
+                for j in 0..self.r {
+                    gss += vv[2][(i, j)] * eta[j];
+                    a += vv[1][(i, j)] * v[1 + j];
+                }
+                v[0] * gss + a
+            } else {
+                v[0] * vv[1][(i, k - 1)]
+            }
+        })
+    }
+    /// (F.6): column s = (Q‴ + V‴η) ṡ² + 2 V″η̇ ṡ, column η_j = V″_j ṡ².
+    fn third_derivative_matrix(&self, z: &[f64], zd: &[f64]) -> Mat<f64> {
+        let (s, eta) = (z[0], &z[1..]);
+        let (sd, etad) = (zd[0], &zd[1..]);
+        let mut wq = self.q.work();
+        self.q.eval(s, &mut wq);
+        let vv = self.v_and_derivatives(s);
+        Mat::from_fn(self.n_q, 1 + self.r, |i, k| {
+            if k == 0 {
+                let mut g3 = wq[3][i];
+                let mut b = 0.0;
+                for j in 0..self.r {
+                    g3 += vv[3][(i, j)] * eta[j];
+                    b += vv[2][(i, j)] * etad[j];
+                }
+                g3 * sd * sd + 2.0 * b * sd
+            } else {
+                vv[2][(i, k - 1)] * sd * sd
+            }
+        })
+    }
     /// (s, 0) with s the knot whose configuration is closest to q0.
     fn z_reference(&self) -> Vec<f64> {
         let dist = |q: &Vec<f64>| {

@@ -12,8 +12,9 @@
 //! fixed basis method G = q0 + Vη (6.16) with modal (5.21) and SVD-modal
 //! (5.22)–(5.23) bases, and the interpolated basis method (6.23) with cubic
 //! splines and modal subspace interpolation (§6.3.3) or MAC-sorted
-//! eigenvectors. Not yet: per-mode SVD (6.19)–(6.21), the path eigenvectors of
-//! chapter 7, the reduced linearization (F.5), saving models, the CLI.
+//! eigenvectors, the per-mode SVD (6.19)–(6.21), the path eigenvectors of
+//! chapter 7 (7.3)–(7.11), reduced statics, the reduced linearization (F.5)
+//! with its rest form (F.7), and saving and loading reduced models.
 //!
 //! ```
 //! use flexmb_reduction::{FixedBasis, ReducedModel};
@@ -34,6 +35,7 @@ mod basis;
 mod ibm;
 mod model;
 mod msi;
+mod path;
 mod saved;
 mod spline;
 
@@ -42,8 +44,11 @@ pub use basis::{
     PerModeSvd, SvdModal,
 };
 pub use ibm::{interpolated_basis_from_sweep, InterpolatedBasis, Knots, SubspaceInterpolation};
-pub use model::{ReducedModel, ReducedTrajectory};
+pub use model::{ReducedLinearization, ReducedModel, ReducedTrajectory};
 pub use msi::{largest_principal_angle, mac_sorted, modal_subspace_interpolation, orthonormalize};
+pub use path::{
+    constrained_eigenvectors, null_space_of_transpose, unconstrained_path_eigenvectors,
+};
 pub use saved::{dof_names, SavedBasis, SavedModel, FORMAT_VERSION};
 pub use spline::CubicSpline;
 

@@ -43,6 +43,10 @@ impl ReducedModel {
     pub fn dynamics(&self) -> &Dynamics {
         &self.dy
     }
+    /// The unreduced dynamics, mutable (e.g. to tighten the position solve).
+    pub fn dynamics_mut(&mut self) -> &mut Dynamics {
+        &mut self.dy
+    }
     /// q = G(z).
     pub fn full_coordinates(&mut self, z: &[f64]) -> Vec<f64> {
         let zd = vec![0.0; z.len()];
@@ -211,6 +215,105 @@ impl ReducedModel {
     pub fn frequencies_at_rest(&mut self, t: f64, z: &[f64]) -> Result<Vec<f64>, ReductionError> {
         let (mz, kz) = self.linearize_at_rest(t, z)?;
         Ok(flexmb_linearize::generalized_symmetric(&kz, &mz, mz.nrows())?.frequencies_hz())
+    }
+}
+
+/// The reduced linearized equations of motion (thesis (F.4)–(F.5)):
+/// Mz δz̈ + (Dz + Cz) δż + (Kz + Gz + Nz) δz = 0.
+#[derive(Clone, Debug)]
+pub struct ReducedLinearization {
+    /// Mz (F.5a).
+    pub m: Mat<f64>,
+    /// Dz + Cz (F.5b)–(F.5c): damping and velocity sensitivity.
+    pub damping: Mat<f64>,
+    /// Kz + Gz + Nz (F.5d)–(F.5f).
+    pub stiffness: Mat<f64>,
+}
+
+impl ReducedModel {
+    /// The reduced residual g_z = G,zᵀ g(G(z), G,z ż, G,z z̈ + (G,zz ż)ż) (F.1).
+    pub fn residual(
+        &mut self,
+        t: f64,
+        z: &[f64],
+        zd: &[f64],
+        zdd: &[f64],
+    ) -> Result<Vec<f64>, ReductionError> {
+        let (q, qd, qdd) = self.full_state(z, zd, zdd);
+        let mut g = vec![0.0; q.len()];
+        self.dy.residual(t, &q, &qd, &qdd, &mut g)?;
+        Ok(self.project(&g))
+    }
+
+    /// q, q̇ and q̈ of a reduced state ((6.13)).
+    fn full_state(&mut self, z: &[f64], zd: &[f64], zdd: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        self.basis
+            .eval(z, zd, &mut self.q, &mut self.gz, &mut self.conv);
+        let nq = self.q.len();
+        let qd: Vec<f64> = (0..nq)
+            .map(|i| {
+                zd.iter()
+                    .enumerate()
+                    .map(|(k, v)| self.gz[(i, k)] * v)
+                    .sum()
+            })
+            .collect();
+        let qdd: Vec<f64> = (0..nq)
+            .map(|i| {
+                self.conv[i]
+                    + zdd
+                        .iter()
+                        .enumerate()
+                        .map(|(k, v)| self.gz[(i, k)] * v)
+                        .sum::<f64>()
+            })
+            .collect();
+        (self.q.clone(), qd, qdd)
+    }
+
+    /// G,zᵀ v.
+    fn project(&self, v: &[f64]) -> Vec<f64> {
+        (0..self.gz.ncols())
+            .map(|k| (0..v.len()).map(|i| self.gz[(i, k)] * v[i]).sum())
+            .collect()
+    }
+
+    /// The reduced linearization (F.5) about any state (z, ż, z̈) at time t,
+    /// by the chain rule through q = G(z) from the unreduced linearization
+    /// (E.5) at (G(z), G,z ż, G,z z̈ + (G,zz ż)ż):
+    ///
+    /// * Mz = G,zᵀ Mq G,z,
+    /// * Dz + Cz = G,zᵀ((Dq + Cq) G,z + 2 Mq G,zz ż),
+    /// * Kz + Gz + Nz = G,zzᵀ g + G,zᵀ((Kq + Gq + Nq) G,z + (Dq + Cq) G,zz ż
+    ///   + Mq (G,zz z̈ + (G,zzz ż)ż)),
+    ///
+    /// with g the unreduced residual (E.1). At rest in equilibrium this is (F.7).
+    pub fn linearize(
+        &mut self,
+        t: f64,
+        z: &[f64],
+        zd: &[f64],
+        zdd: &[f64],
+    ) -> Result<ReducedLinearization, ReductionError> {
+        let (q, qd, qdd) = self.full_state(z, zd, zdd);
+        let mut g = vec![0.0; q.len()];
+        self.dy.residual(t, &q, &qd, &qdd, &mut g)?;
+        let lin = self.dy.linearize(t, &q, &qd, &qdd)?;
+        let gz = self.gz.clone();
+        let h_zd = self.basis.second_derivative_matrix(z, zd);
+        let h_zdd = self.basis.second_derivative_matrix(z, zdd);
+        let h3 = self.basis.third_derivative_matrix(z, zd);
+        let dc = &lin.d + &lin.c;
+        let m = gz.transpose() * &lin.m * &gz;
+        let damping = gz.transpose() * (&dc * &gz + (&lin.m * &h_zd) * 2.0);
+        let mut stiffness =
+            gz.transpose() * (lin.stiffness_total() * &gz + &dc * &h_zd + &lin.m * (&h_zdd + &h3));
+        stiffness += &self.basis.hessian_contraction(z, &g);
+        Ok(ReducedLinearization {
+            m,
+            damping,
+            stiffness,
+        })
     }
 }
 
