@@ -5,12 +5,10 @@
 use xtask::progress::Progress;
 use xtask::regress::{check, recompute_ch5, recompute_ch6, RTOL};
 
-#[test]
-fn chapter_5_curves_match_the_stored_ones() {
-    let root = xtask::workspace_root();
-    let r = recompute_ch5(&root, &Progress::hidden()).unwrap();
-    assert_eq!(r.curves.len(), 5, "unreduced and four reduced models");
-    let d = check(&r);
+/// Asserts that the recomputed curves of `models` models agree with the stored ones.
+fn assert_matches_fixtures(r: &xtask::regress::Recomputed, models: usize) {
+    assert_eq!(r.curves.len(), models, "unreduced and every reduced model");
+    let d = check(r);
     assert!(
         d.is_empty(),
         "{} differences (tolerance {RTOL:e}):\n{}",
@@ -20,17 +18,15 @@ fn chapter_5_curves_match_the_stored_ones() {
 }
 
 #[test]
+fn chapter_5_curves_match_the_stored_ones() {
+    let root = xtask::workspace_root();
+    assert_matches_fixtures(&recompute_ch5(&root, &Progress::hidden()).unwrap(), 5);
+}
+
+#[test]
 fn chapter_6_curves_match_the_stored_ones() {
     let root = xtask::workspace_root();
-    let r = recompute_ch6(&root, &Progress::hidden()).unwrap();
-    assert_eq!(r.curves.len(), 8, "unreduced and seven reduced models");
-    let d = check(&r);
-    assert!(
-        d.is_empty(),
-        "{} differences (tolerance {RTOL:e}):\n{}",
-        d.len(),
-        d.join("\n")
-    );
+    assert_matches_fixtures(&recompute_ch6(&root, &Progress::hidden()).unwrap(), 8);
 }
 
 /// A change of the model must fail the comparison. A density change of 1e-4

@@ -16,6 +16,12 @@ pub struct ReducedModel {
     qd: Vec<f64>,
     gz: Mat<f64>,
     conv: Vec<f64>,
+    /// Work space of the equations of motion (no allocation per evaluation
+    /// here; the Cholesky factor of Mz is the one allocation left).
+    r: Vec<f64>,
+    mg: Mat<f64>,
+    mz: Mat<f64>,
+    fz: Mat<f64>,
 }
 
 impl ReducedModel {
@@ -28,6 +34,10 @@ impl ReducedModel {
             qd: vec![0.0; nq],
             gz: Mat::zeros(nq, nz),
             conv: vec![0.0; nq],
+            r: vec![0.0; nq],
+            mg: Mat::zeros(nq, nz),
+            mz: Mat::zeros(nz, nz),
+            fz: Mat::zeros(nz, 1),
             basis,
         }
     }
@@ -70,25 +80,45 @@ impl ReducedModel {
             *v = (0..nz).map(|k| self.gz[(i, k)] * zd[k]).sum();
         }
         let (mq, rhs) = self.dy.mass_and_force(t, &self.q, &self.qd)?;
-        let mut r: Vec<f64> = rhs.to_vec();
-        if self.conv.iter().any(|c| *c != 0.0) {
+        let (r, gz, conv) = (&mut self.r, &self.gz, &self.conv);
+        r.copy_from_slice(rhs);
+        if conv.iter().any(|c| *c != 0.0) {
             for (i, ri) in r.iter_mut().enumerate() {
-                *ri -= (0..self.conv.len())
-                    .map(|j| mq[(i, j)] * self.conv[j])
-                    .sum::<f64>();
+                *ri -= (0..conv.len()).map(|j| mq[(i, j)] * conv[j]).sum::<f64>();
             }
         }
-        let mg = mq * &self.gz;
-        let mz = self.gz.transpose() * &mg;
-        let mut fz = Mat::from_fn(nz, 1, |k, _| {
-            (0..r.len()).map(|i| self.gz[(i, k)] * r[i]).sum::<f64>()
-        });
-        let llt = mz
+        use faer::linalg::matmul::matmul;
+        matmul(
+            self.mg.as_mut(),
+            faer::Accum::Replace,
+            mq,
+            gz,
+            1.0,
+            faer::Par::Seq,
+        );
+        matmul(
+            self.mz.as_mut(),
+            faer::Accum::Replace,
+            gz.transpose(),
+            &self.mg,
+            1.0,
+            faer::Par::Seq,
+        );
+        for k in 0..nz {
+            self.fz[(k, 0)] = gz
+                .col_as_slice(k)
+                .iter()
+                .zip(r.iter())
+                .map(|(g, v)| g * v)
+                .sum();
+        }
+        let llt = self
+            .mz
             .llt(faer::Side::Lower)
             .map_err(|_| ReductionError::SingularMass)?;
-        llt.solve_in_place(fz.as_mut());
+        llt.solve_in_place(self.fz.as_mut());
         for (k, v) in zdd.iter_mut().enumerate() {
-            *v = fz[(k, 0)];
+            *v = self.fz[(k, 0)];
         }
         Ok(())
     }
@@ -383,8 +413,7 @@ impl OdeSystem for ReducedModel {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         let n = self.basis.n_z();
         let (z, zd) = y.split_at(n);
-        let mut zdd = vec![0.0; n];
-        self.accelerations(t, z, zd, &mut zdd)
+        self.accelerations(t, z, zd, &mut dy[n..])
             .map_err(|e| match e {
                 ReductionError::Dynamics(flexmb_dynamics::DynamicsError::Kinematics { .. }) => {
                     RhsError::recoverable(e.to_string())
@@ -392,7 +421,6 @@ impl OdeSystem for ReducedModel {
                 _ => RhsError::new(e.to_string()),
             })?;
         dy[..n].copy_from_slice(zd);
-        dy[n..].copy_from_slice(&zdd);
         Ok(())
     }
 }
