@@ -13,6 +13,7 @@ enum Column {
     Kinetic,
     Elastic,
     Gravitational,
+    ExternalWork,
     Q(usize),
 }
 
@@ -21,6 +22,9 @@ pub struct OutputTable {
     columns: Vec<Column>,
     /// Column names.
     pub header: Vec<String>,
+    /// (t, external power, external work) of the previous row: the work is
+    /// the trapezoidal integral of the power over the rows.
+    work: std::cell::Cell<Option<(f64, f64, f64)>>,
 }
 
 impl OutputTable {
@@ -96,11 +100,17 @@ impl OutputTable {
                     }
                 }
                 OutputSpec::Energies => {
-                    columns.extend([Column::Kinetic, Column::Elastic, Column::Gravitational]);
+                    columns.extend([
+                        Column::Kinetic,
+                        Column::Elastic,
+                        Column::Gravitational,
+                        Column::ExternalWork,
+                    ]);
                     header.extend([
                         "kinetic".to_string(),
                         "elastic".into(),
                         "gravitational".into(),
+                        "external_work".into(),
                     ]);
                 }
                 OutputSpec::Dofs => {
@@ -111,10 +121,18 @@ impl OutputTable {
                 }
             }
         }
-        Ok(Self { columns, header })
+        Ok(Self {
+            columns,
+            header,
+            work: std::cell::Cell::new(None),
+        })
     }
 
-    /// One row at (t, q, q̇).
+    /// One row at (t, q, q̇). Rows must come in time order: the external
+    /// work column is the work of loads, gravity and controllers since the
+    /// first row, integrated over the rows by the trapezoidal rule (error
+    /// O(Δt²) in the output interval), so that kinetic + elastic − external
+    /// work stays constant up to that error (gravity's work is −Δ gravitational).
     pub fn row(
         &self,
         dy: &mut Dynamics,
@@ -130,6 +148,21 @@ impl OutputTable {
             Some(dy.energies(t, q, qd)?)
         } else {
             None
+        };
+        let work = if self
+            .columns
+            .iter()
+            .any(|c| matches!(c, Column::ExternalWork))
+        {
+            let p = dy.external_power(t, q, qd)?;
+            let w = match self.work.get() {
+                Some((t0, p0, w0)) => w0 + 0.5 * (t - t0) * (p + p0),
+                None => 0.0,
+            };
+            self.work.set(Some((t, p, w)));
+            w
+        } else {
+            0.0
         };
         dy.kinematics_at(t, q, Some(qd))?;
         dy.forces(t, true);
@@ -148,6 +181,7 @@ impl OutputTable {
                 Column::Kinetic => en.map_or(0.0, |e| e.kinetic),
                 Column::Elastic => en.map_or(0.0, |e| e.elastic),
                 Column::Gravitational => en.map_or(0.0, |e| e.gravitational),
+                Column::ExternalWork => work,
                 Column::Q(k) => q[*k],
             })
             .collect())

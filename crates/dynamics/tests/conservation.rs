@@ -106,3 +106,69 @@ fn reversing_the_elements_gives_the_same_spatial_spin_up_response() {
         "tip positions differ by {diff} m after reversing the elements"
     );
 }
+
+/// Kinetic + elastic − external work along a simulation of `name` (the
+/// external work includes gravity's): its largest deviation and the largest
+/// |work|, and the change of the gravitational energy.
+fn work_balance(name: &str, t_end: f64) -> (f64, f64, f64) {
+    let mech = Arc::new(scene(name).build(None).unwrap());
+    let mut dy = Dynamics::new(mech.clone());
+    let q0 = mech.q0();
+    let qd0 = dy.initial_qd(0.0, &q0).unwrap();
+    let mut opts = SimulationOptions::new(Integrator::Dopri5, 0.0, t_end, 2001);
+    opts.rtol = 1e-8;
+    opts.atol = 1e-11;
+    let tr = dy
+        .simulate(0.0, &q0, &qd0, &opts, |_, _, _| Control::Continue)
+        .unwrap();
+    let mut s = scene(name);
+    s.outputs = vec![flexmb_model::OutputSpec::Energies];
+    let table = flexmb_dynamics::OutputTable::new(&Dynamics::new(Arc::new(s.build(None).unwrap())))
+        .unwrap();
+    let col = |n: &str| table.header.iter().position(|h| h == n).unwrap();
+    let (k, e, g, w) = (
+        col("kinetic"),
+        col("elastic"),
+        col("gravitational"),
+        col("external_work"),
+    );
+    let rows: Vec<Vec<f64>> =
+        tr.t.iter()
+            .zip(tr.q.iter().zip(&tr.qd))
+            .map(|(t, (q, qd))| table.row(&mut dy, *t, q, qd).unwrap())
+            .collect();
+    let balance = |r: &Vec<f64>| r[k] + r[e] - r[w];
+    let b0 = balance(&rows[0]);
+    let work = rows.iter().fold(0.0f64, |m, r| m.max(r[w].abs()));
+    let worst = rows
+        .iter()
+        .fold(0.0f64, |m, r| m.max((balance(r) - b0).abs()));
+    let dg = rows
+        .iter()
+        .fold(0.0f64, |m, r| m.max((r[g] - rows[0][g]).abs()));
+    (worst, work, dg)
+}
+
+/// The external-work output balances the energy: of the planar straight
+/// guidance driven by the force pulse (5.24), and of the flexible pendulum
+/// falling under gravity, whose external work is the drop of its
+/// gravitational energy. The tolerance is the trapezoidal rule's over 2000
+/// output intervals.
+#[test]
+fn external_work_balances_the_energy() {
+    let (worst, work, _) = work_balance("straight_guidance_planar.ron", 0.15);
+    assert!(work > 1.0, "the pulse does work: {work} J");
+    assert!(
+        worst < 1e-4 * work,
+        "guidance: balance off by {worst:e} J of {work} J"
+    );
+    let (worst, work, dg) = work_balance("flexible_pendulum.ron", 0.3);
+    assert!(
+        (work - dg).abs() < 1e-3 * dg,
+        "gravity's work {work} J against the drop {dg} J"
+    );
+    assert!(
+        worst < 1e-4 * work,
+        "pendulum: balance off by {worst:e} J of {work} J"
+    );
+}
