@@ -690,3 +690,92 @@ fn reduced_models_are_refused_where_they_do_not_apply() {
     assert!(e.contains("not a reduced model"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn per_mode_svd_and_mac_sorted_models_report_and_bound_the_frequencies() {
+    let dir = temp_dir("fbm-mac");
+    let scene = fixture(GUIDANCE);
+    let full = load_sweep(&scene, None, ["0", "0", "1"], &dir.join("full"));
+    let fbm = dir.join("fbm.ron");
+    let s = run_ok(&[
+        "reduce",
+        &scene,
+        "--method",
+        "fbm-svd",
+        "--modes",
+        "3",
+        "--over",
+        "load",
+        "--from",
+        "-1",
+        "--to",
+        "1",
+        "--n",
+        "30",
+        "--t-load",
+        T_LOAD,
+        "--out",
+        fbm.to_str().unwrap(),
+    ]);
+    // one column per mode and one for the last SVD; the printed counts match
+    // the 1 % and 0.5 % rules and the model's size
+    let sv = dir.join("fbm.singular_values.csv");
+    let (h, _) = flexmb_plot_read(&sv);
+    assert_eq!(h, vec!["index", "mode1", "mode2", "mode3", "final"]);
+    for (col, th) in [
+        ("mode1", 0.01),
+        ("mode2", 0.01),
+        ("mode3", 0.01),
+        ("final", 0.005),
+    ] {
+        let v: Vec<f64> = column(&sv, col)
+            .into_iter()
+            .filter(|x| !x.is_nan())
+            .collect();
+        assert!((v.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{col}");
+        let kept = v.iter().filter(|x| **x > th).count();
+        assert!(
+            s.contains(&format!("{col:<8} kept {kept} of {}", v.len())),
+            "{col}: {s}"
+        );
+        if col == "final" {
+            assert!(
+                s.contains(&format!("reduced model: {kept} coordinates")),
+                "{s}"
+            );
+        }
+    }
+    // a fixed basis at the reference is a Rayleigh–Ritz subspace: upper bounds
+    let f = column(&dir.join("fbm.frequencies.csv"), "reduced_hz");
+    for k in 0..3 {
+        assert!(f[k] >= full[0][k + 1] * (1.0 - 1e-12), "ω{}", k + 1);
+        assert!(rel(f[k], full[0][k + 1]) < 1e-3, "ω{}: {}", k + 1, f[k]);
+    }
+    // MAC-sorted eigenvectors are eigenvectors at the knots, as MSI's span
+    let nodal = nodal_guidance(&dir);
+    let mac = dir.join("mac3.ron");
+    run_ok(&[
+        "reduce",
+        &nodal,
+        "--method",
+        "ibm-mac",
+        "--modes",
+        "2",
+        "--over",
+        "S.x",
+        "--from",
+        "-0.05",
+        "--to",
+        "0.05",
+        "--n",
+        "11",
+        "--out",
+        mac.to_str().unwrap(),
+    ]);
+    let f = column(&dir.join("mac3.frequencies.csv"), "reduced_hz");
+    assert_eq!(f.len(), 3);
+    for k in 1..3 {
+        assert!(rel(f[k], full[0][k + 1]) < 1e-8, "ω{}: {}", k + 1, f[k]);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
