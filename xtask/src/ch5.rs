@@ -17,7 +17,7 @@ use flexmb_dynamics::{Integrator, SimulationOptions};
 use flexmb_linearize::{sweep, SweepOptions, SweepParameter};
 use flexmb_model::{Component, DofChoice, Mechanism, Scene, Select};
 use flexmb_plot::{write_csv, Plot, Series};
-use flexmb_reduction::{modal_basis, svd_modal_basis, SvdModal};
+use flexmb_reduction::{modal_basis, svd_modal_basis, SvdModal, SVD_THRESHOLD};
 use rayon::prelude::*;
 use std::fmt::Write;
 use std::path::Path;
@@ -110,8 +110,8 @@ pub fn guidance_from(scene: Scene) -> Result<Guidance, String> {
     .map_err(|e| e.to_string())?;
     let e = |x: flexmb_reduction::ReductionError| x.to_string();
     let q = mech.q0();
-    let svd0 = svd_modal_basis(&q, &pts, 3, 0.0, 0.01).map_err(e)?;
-    let svd1 = svd_modal_basis(&q, &pts, 3, 1.0, 0.01).map_err(e)?;
+    let svd0 = svd_modal_basis(&q, &pts, 3, 0.0, SVD_THRESHOLD).map_err(e)?;
+    let svd1 = svd_modal_basis(&q, &pts, 3, 1.0, SVD_THRESHOLD).map_err(e)?;
     let models = vec![
         Model::new("Unreduced", &mech, ModelKind::Unreduced),
         Model::new(

@@ -11,7 +11,7 @@ use flexmb_linearize::{sweep, SweepOptions, SweepParameter, SweepPoint};
 use flexmb_model::{Component, DofChoice, Mechanism, Scene, Select};
 use flexmb_reduction::{
     interpolated_basis_from_sweep, modal_basis, per_mode_svd_basis, PerModeSvd,
-    SubspaceInterpolation,
+    SubspaceInterpolation, SVD_THRESHOLD,
 };
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -25,14 +25,9 @@ pub const NODE: &str = "S";
 /// quasi-static curves scale the loads at this time.
 pub const T_LOAD: f64 = 0.05;
 
-/// The selection rule of the last SVD of §6.3.2 (step 9), relative to the sum
-/// of the singular values. Steps 5–6 use the thesis's 1 %. Step 9 only removes
-/// linear dependencies: for SVD-13 the thesis kept 13 of 16 vectors, "the last
-/// three with a smaller contribution than the first ten" (Fig. 6.8b). Our
-/// values show the same structure (ten above 1 %, three between 0.88 % and
-/// 1.1 %, three below 0.11 %), so step 9 keeps those above 0.5 %; with 1 % it
-/// would keep 11. SVD-7 keeps 7 with either rule.
-pub const FINAL_THRESHOLD: f64 = 0.005;
+/// The selection rule of the last SVD of §6.3.2 (step 9); the reasoning is at
+/// [`flexmb_reduction::FINAL_SVD_THRESHOLD`].
+pub const FINAL_THRESHOLD: f64 = flexmb_reduction::FINAL_SVD_THRESHOLD;
 
 /// Settings of the chapter 6 benchmark.
 #[derive(Clone, Debug)]
@@ -249,9 +244,10 @@ pub fn models(s: &Setup, r: &References) -> Result<Models, String> {
     let q0d = s.def.q0();
     let q0n = s.nod.q0();
     let modal2 = modal_basis(&s.def_nog, 0.0, &q0d, 2, None).map_err(e)?;
-    let svd7 = per_mode_svd_basis(&q0d, &r.fbm, &[0, 1], 0.01, FINAL_THRESHOLD).map_err(e)?;
-    let svd13 =
-        per_mode_svd_basis(&q0d, &r.fbm, &[0, 1, 2, 3], 0.01, FINAL_THRESHOLD).map_err(e)?;
+    let svd7 =
+        per_mode_svd_basis(&q0d, &r.fbm, &[0, 1], SVD_THRESHOLD, FINAL_THRESHOLD).map_err(e)?;
+    let svd13 = per_mode_svd_basis(&q0d, &r.fbm, &[0, 1, 2, 3], SVD_THRESHOLD, FINAL_THRESHOLD)
+        .map_err(e)?;
     let ibm = |pts: &[SweepPoint], r: usize, m: SubspaceInterpolation| {
         interpolated_basis_from_sweep(q0n.clone(), s.s_dof, pts, 1..1 + r, m, true).map_err(e)
     };

@@ -6,7 +6,7 @@ use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions, StaticOp
 use flexmb_kinematics::Kinematics;
 use flexmb_linearize::undamped_modes;
 use flexmb_model::Mechanism;
-use flexmb_reduction::{Basis, FixedBasis, InterpolatedBasis, ReducedModel};
+use flexmb_reduction::{load_scale_path, Basis, FixedBasis, InterpolatedBasis, ReducedModel};
 use std::sync::Arc;
 
 /// How a model constrains the degrees of freedom.
@@ -133,6 +133,13 @@ impl Solver {
             Solver::Full(_, q) | Solver::Reduced(_, q) => *q = s,
         }
     }
+    /// Scales the scene's loads by λ (gravity stays).
+    fn set_load_scale(&mut self, lambda: f64) {
+        match self {
+            Solver::Full(dy, _) => dy.set_load_scale(lambda),
+            Solver::Reduced(r, _) => r.set_load_scale(lambda),
+        }
+    }
     /// Equilibrium at load scale λ from the current state.
     fn equilibrium(&mut self, t: f64, lambda: f64, first: bool) -> Result<(), String> {
         match self {
@@ -184,35 +191,10 @@ impl Solver {
     }
 }
 
-/// Continuation to load scale `to` from the solver's current equilibrium at
-/// `from`, in 1, 2, 4, … 64 substeps (halving on failure).
-fn continue_to(s: &mut Solver, t: f64, from: f64, to: f64) -> Result<(), String> {
-    let start = s.state();
-    let mut err = String::new();
-    for n in [1usize, 2, 4, 8, 16, 32, 64] {
-        s.set_state(start.clone());
-        let mut ok = true;
-        for k in 1..=n {
-            let l = from + (to - from) * k as f64 / n as f64;
-            if let Err(e) = s.equilibrium(t, l, false) {
-                err = e;
-                ok = false;
-                break;
-            }
-        }
-        if ok {
-            return Ok(());
-        }
-    }
-    s.set_state(start);
-    Err(format!(
-        "no equilibrium at load scale {to:.4} (from {from:.4}, 64 substeps): {err}"
-    ))
-}
-
 /// The quasi-static eigenfrequency curve of a model: at each load scale of
-/// `lambdas` (ascending, loads evaluated at `t`, gravity as in the scene) the
-/// static equilibrium by continuation from λ = 0 outwards, the probed node's
+/// `lambdas` (loads evaluated at `t`, gravity as in the scene) the static
+/// equilibrium by continuation from λ = 0 outwards
+/// ([`flexmb_reduction::load_scale_path`]), the probed node's
 /// position and the eigenfrequencies of the rest linearization ((E.6) or
 /// (F.7)). `count` limits the unreduced model's frequencies.
 pub fn quasi_static_curve(
@@ -227,34 +209,30 @@ pub fn quasi_static_curve(
     let mut s = Solver::new(model);
     s.equilibrium(t, 0.0, true).map_err(ctx)?;
     let at_zero = s.state();
-    let mid = lambdas.partition_point(|l| *l < 0.0);
-    let mut out: Vec<Option<CurvePoint>> = vec![None; lambdas.len()];
-    let mut point = |s: &mut Solver, l: f64| -> Result<CurvePoint, String> {
-        let q = s.q();
-        let (freqs, highest) = s.frequencies(t, count)?;
-        Ok(CurvePoint {
-            lambda: l,
-            position: probe.displacement(&q, t)?,
-            freqs,
-            highest,
-        })
+    // continuation outwards from λ = 0 (shared with `flexmb sweep --reduced`)
+    let mut solve = |state: &Vec<f64>, l: f64| -> Result<Vec<f64>, String> {
+        s.set_state(state.clone());
+        s.equilibrium(t, l, false)?;
+        Ok(s.state())
     };
-    // upwards from 0, then downwards from 0
-    let mut prev = 0.0;
-    for (i, l) in lambdas.iter().enumerate().skip(mid) {
-        continue_to(&mut s, t, prev, *l).map_err(ctx)?;
-        out[i] = Some(point(&mut s, *l).map_err(ctx)?);
-        prev = *l;
-    }
-    s.set_state(at_zero);
-    prev = 0.0;
-    for i in (0..mid).rev() {
-        let l = lambdas[i];
-        continue_to(&mut s, t, prev, l).map_err(ctx)?;
-        out[i] = Some(point(&mut s, l).map_err(ctx)?);
-        prev = l;
-    }
-    Ok(out.into_iter().flatten().collect())
+    let states = load_scale_path(&at_zero, lambdas, &mut solve, &mut |_| {})
+        .map_err(|e| ctx(e.to_string()))?;
+    lambdas
+        .iter()
+        .zip(states)
+        .map(|(l, state)| {
+            s.set_state(state);
+            s.set_load_scale(*l);
+            let q = s.q();
+            let (freqs, highest) = s.frequencies(t, count).map_err(ctx)?;
+            Ok(CurvePoint {
+                lambda: *l,
+                position: probe.displacement(&q, t).map_err(ctx)?,
+                freqs,
+                highest,
+            })
+        })
+        .collect()
 }
 
 /// A time response and what it cost.

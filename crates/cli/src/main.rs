@@ -3,13 +3,18 @@
 //! Exit codes: 0 success, 1 a computation failed, 2 invalid input (scene,
 //! options), 130 interrupted (partial results are written).
 
-use clap::{Parser, Subcommand};
-use flexmb_dynamics::{
-    Control, Dynamics, Integrator, OutputTable, SimulationOptions, StaticOptions,
-};
+mod coords;
+mod reduce;
+mod reduced;
+mod report;
+
+use clap::{Args, Parser, Subcommand};
+use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions, StaticOptions};
 use flexmb_model::Scene;
-use flexmb_plot::{write_csv, Plot, Series};
-use indicatif::{ProgressBar, ProgressStyle};
+use flexmb_plot::write_csv;
+use report::{
+    count_bar, linspace, time_bar, write_frequency_sweep, write_outputs, FrequencySweep, Response,
+};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -21,7 +26,7 @@ use std::sync::Arc;
     version,
     about = "Flexible multibody dynamics and model reduction for compliant mechanisms",
     long_about = "Flexible multibody dynamics and model reduction for compliant mechanisms.\n\nScenes are RON files (see docs/scene-format.md); examples are in fixtures/scenes/.",
-    after_help = "Examples:\n  flexmb info fixtures/scenes/straight_guidance_spatial.ron\n  flexmb static fixtures/scenes/straight_guidance_spatial.ron --out results/static\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --t-end 0.5 --out results/sim\n  flexmb simulate fixtures/scenes/spin_up_planar.ron --t-end 20 --integrator adams --rtol 1e-6\n  flexmb build-superelement spec.ron"
+    after_help = "Examples:\n  flexmb info fixtures/scenes/straight_guidance_spatial.ron\n  flexmb static fixtures/scenes/straight_guidance_spatial.ron --out results/static\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --t-end 0.5 --out results/sim\n  flexmb simulate fixtures/scenes/spin_up_planar.ron --t-end 20 --integrator adams --rtol 1e-6\n  flexmb reduce fixtures/scenes/straight_guidance_planar.ron --method modal --modes 3 --out modal3.ron\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --reduced modal3.ron --t-end 0.5\n  flexmb build-superelement spec.ron"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -50,31 +55,7 @@ enum Command {
         out: PathBuf,
     },
     /// Time response from the reference configuration (or from equilibrium with --static-first).
-    Simulate {
-        /// Scene file (RON).
-        scene: PathBuf,
-        /// End time (s).
-        #[arg(long, default_value_t = 1.0)]
-        t_end: f64,
-        /// Number of output points.
-        #[arg(long, default_value_t = 501)]
-        outputs: usize,
-        /// dopri5 (ode45-like), adams (Shampine–Gordon) or genalpha (implicit).
-        #[arg(long, default_value = "dopri5")]
-        integrator: String,
-        /// Relative tolerance (ode45 default 1e-3).
-        #[arg(long, default_value_t = 1e-3)]
-        rtol: f64,
-        /// Absolute tolerance (ode45 default 1e-6).
-        #[arg(long, default_value_t = 1e-6)]
-        atol: f64,
-        /// Start from the static equilibrium at t = 0.
-        #[arg(long)]
-        static_first: bool,
-        /// Output directory.
-        #[arg(long, default_value = "results/simulate")]
-        out: PathBuf,
-    },
+    Simulate(SimulateArgs),
     /// Eigenfrequencies at the reference configuration or at the static equilibrium.
     Eig {
         /// Scene file (RON).
@@ -91,30 +72,10 @@ enum Command {
     },
     /// Eigenfrequencies along the range of motion: over a load scale or a
     /// held coordinate, n equilibria, eigen analyses in parallel.
-    Sweep {
-        /// Scene file (RON).
-        scene: PathBuf,
-        /// `load` (scale the scene's loads) or a coordinate/deformation name
-        /// such as `S.x` or `flexure1.3.bending_z_p` (`flexmb info` lists them);
-        /// a coordinate is swept as its change from the reference configuration.
-        #[arg(long)]
-        over: String,
-        /// First value of the sweep parameter.
-        #[arg(long)]
-        from: f64,
-        /// Last value.
-        #[arg(long)]
-        to: f64,
-        /// Number of configurations.
-        #[arg(long, default_value_t = 50)]
-        n: usize,
-        /// Modes per configuration.
-        #[arg(long, default_value_t = 6)]
-        modes: usize,
-        /// Output directory.
-        #[arg(long, default_value = "results/sweep")]
-        out: PathBuf,
-    },
+    Sweep(SweepArgs),
+    /// Build a reduced model (fixed or interpolated basis) of a scene and save
+    /// it for `simulate --reduced` and `sweep --reduced` (see docs/cli.md).
+    Reduce(reduce::ReduceArgs),
     /// Build a linear superelement from FE matrices (see crates/superelement/README.md).
     BuildSuperelement {
         /// Specification file (RON).
@@ -122,12 +83,87 @@ enum Command {
     },
 }
 
+/// Options of `flexmb simulate`.
+#[derive(Args)]
+struct SimulateArgs {
+    /// Scene file (RON).
+    scene: PathBuf,
+    /// End time (s).
+    #[arg(long, default_value_t = 1.0)]
+    t_end: f64,
+    /// Number of output points.
+    #[arg(long, default_value_t = 501)]
+    outputs: usize,
+    /// dopri5 (ode45-like), adams (Shampine–Gordon) or genalpha (implicit;
+    /// unreduced models only).
+    #[arg(long, default_value = "dopri5")]
+    integrator: String,
+    /// Relative tolerance (ode45 default 1e-3).
+    #[arg(long, default_value_t = 1e-3)]
+    rtol: f64,
+    /// Absolute tolerance (ode45 default 1e-6).
+    #[arg(long, default_value_t = 1e-6)]
+    atol: f64,
+    /// Start from the static equilibrium at t = 0.
+    #[arg(long)]
+    static_first: bool,
+    /// Integrate this reduced model of the scene (written by `flexmb reduce`)
+    /// instead of all degrees of freedom; explicit integrators only.
+    #[arg(long, value_name = "MODEL.ron")]
+    reduced: Option<PathBuf>,
+    /// Output directory.
+    #[arg(long, default_value = "results/simulate")]
+    out: PathBuf,
+}
+
+/// Options of `flexmb sweep`.
+#[derive(Args)]
+struct SweepArgs {
+    /// Scene file (RON).
+    scene: PathBuf,
+    /// `load` (scale the scene's loads) or a coordinate/deformation name
+    /// such as `S.x` or `flexure1.3.bending_z_p` (`flexmb info` lists them);
+    /// a coordinate is swept as its change from the reference configuration.
+    /// With --reduced: `load` only.
+    #[arg(long)]
+    over: String,
+    /// First value of the sweep parameter.
+    #[arg(long, allow_negative_numbers = true)]
+    from: f64,
+    /// Last value.
+    #[arg(long, allow_negative_numbers = true)]
+    to: f64,
+    /// Number of configurations.
+    #[arg(long, default_value_t = 50)]
+    n: usize,
+    /// Modes per configuration.
+    #[arg(long, default_value_t = 6)]
+    modes: usize,
+    /// Time at which the scene's loads are evaluated (a load sweep scales
+    /// them: pick a time where they act, e.g. the peak of a pulse).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    t_load: f64,
+    /// Sweep this reduced model of the scene (written by `flexmb reduce`):
+    /// reduced static equilibria by continuation from load scale 0, reduced
+    /// eigenfrequencies (F.7) at each.
+    #[arg(long, value_name = "MODEL.ron")]
+    reduced: Option<PathBuf>,
+    /// Output directory.
+    #[arg(long, default_value = "results/sweep")]
+    out: PathBuf,
+}
+
+/// Why a command failed, which decides the exit code.
 enum Failure {
+    /// Invalid input: scene, model or options (exit code 2).
     Input(String),
+    /// A computation failed (exit code 1).
     Compute(String),
+    /// Stopped by Ctrl-C after writing partial results (exit code 130).
     Interrupted,
 }
 
+/// Reads a scene and builds its mechanism.
 fn load(path: &Path) -> Result<(Scene, Arc<flexmb_model::Mechanism>), Failure> {
     let scene = Scene::load(path).map_err(|e| Failure::Input(e.to_string()))?;
     let mech = scene
@@ -136,6 +172,7 @@ fn load(path: &Path) -> Result<(Scene, Arc<flexmb_model::Mechanism>), Failure> {
     Ok((scene, Arc::new(mech)))
 }
 
+/// A failed write.
 fn io_err(e: std::io::Error, what: &Path) -> Failure {
     Failure::Compute(format!("cannot write {}: {e}", what.display()))
 }
@@ -155,41 +192,15 @@ fn main() -> ExitCode {
             steps,
             out,
         } => statics(&scene, time, steps, &out),
-        Command::Simulate {
-            scene,
-            t_end,
-            outputs,
-            integrator,
-            rtol,
-            atol,
-            static_first,
-            out,
-        } => simulate(
-            &scene,
-            t_end,
-            outputs,
-            &integrator,
-            rtol,
-            atol,
-            static_first,
-            &out,
-            &interrupted,
-        ),
+        Command::Simulate(a) => simulate(&a, &interrupted),
         Command::Eig {
             scene,
             modes,
             static_first,
             buckling,
         } => eig(&scene, modes, static_first, buckling),
-        Command::Sweep {
-            scene,
-            over,
-            from,
-            to,
-            n,
-            modes,
-            out,
-        } => sweep(&scene, &over, from, to, n, modes, &out),
+        Command::Sweep(a) => sweep(&a),
+        Command::Reduce(a) => reduce::reduce(&a),
         Command::BuildSuperelement { spec } => build_superelement(&spec),
     };
     match result {
@@ -286,30 +297,71 @@ fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure>
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
-fn simulate(
-    path: &Path,
-    t_end: f64,
-    n_out: usize,
-    integrator: &str,
-    rtol: f64,
-    atol: f64,
-    static_first: bool,
-    out: &Path,
-    interrupted: &Arc<AtomicBool>,
-) -> Result<(), Failure> {
-    let integrator: Integrator = integrator.parse().map_err(Failure::Input)?;
-    if !(t_end > 0.0 && t_end.is_finite()) {
+/// `flexmb simulate`: the scene's time response, unreduced or with a reduced
+/// model, written by [`write_outputs`].
+fn simulate(a: &SimulateArgs, interrupted: &Arc<AtomicBool>) -> Result<(), Failure> {
+    let integrator: Integrator = a.integrator.parse().map_err(Failure::Input)?;
+    if !(a.t_end > 0.0 && a.t_end.is_finite()) {
         return Err(Failure::Input(format!(
-            "--t-end must be positive, got {t_end}"
+            "--t-end must be positive, got {}",
+            a.t_end
         )));
     }
-    if !(rtol > 0.0 && atol > 0.0) {
+    if !(a.rtol > 0.0 && a.atol > 0.0) {
         return Err(Failure::Input("--rtol and --atol must be positive".into()));
     }
-    let (_, mech) = load(path)?;
+    let (_, mech) = load(&a.scene)?;
+    let mut opts = SimulationOptions::new(integrator, 0.0, a.t_end, a.outputs);
+    opts.rtol = a.rtol;
+    opts.atol = a.atol;
+    let pb = time_bar();
+    let flag = interrupted.clone();
+    let t_end = a.t_end;
+    let observer = |t: f64| {
+        pb.set_position((1000.0 * t / t_end) as u64);
+        pb.set_message(format!("{t:.4}"));
+        if flag.load(Ordering::SeqCst) {
+            Control::Stop
+        } else {
+            Control::Continue
+        }
+    };
     let mut dy = Dynamics::new(mech.clone());
-    let mut q0 = mech.q0();
+    let result = match &a.reduced {
+        None => {
+            println!("{}", mech.summary());
+            simulate_unreduced(&mut dy, &opts, a.static_first, observer).map(|r| (r, None))
+        }
+        Some(model) => reduced::simulate(&mech, model, &opts, a.static_first, observer)
+            .map(|(r, d)| (r, Some(d))),
+    };
+    pb.finish_and_clear();
+    let (response, model) = result?;
+    println!("{}", response.summary());
+    let mut comments = vec![format!("flexmb simulate {}", a.scene.display())];
+    if let (Some(m), Some(d)) = (&a.reduced, &model) {
+        comments.push(format!("reduced model {}: {d}", m.display()));
+    }
+    comments.push(format!(
+        "integrator {integrator:?}, rtol {:e}, atol {:e}, {} function evaluations",
+        a.rtol, a.atol, response.stats.rhs_evals
+    ));
+    write_outputs(&mut dy, &response, &comments, &a.out)?;
+    if response.stopped {
+        return Err(Failure::Interrupted);
+    }
+    Ok(())
+}
+
+/// Integrates all degrees of freedom from the reference configuration (or
+/// the static equilibrium) with the scene's initial velocities.
+fn simulate_unreduced(
+    dy: &mut Dynamics,
+    opts: &SimulationOptions,
+    static_first: bool,
+    mut observer: impl FnMut(f64) -> Control,
+) -> Result<Response, Failure> {
+    let mut q0 = dy.mechanism().q0();
     if static_first {
         q0 = dy
             .static_equilibrium(0.0, &q0, &StaticOptions::default())
@@ -319,88 +371,17 @@ fn simulate(
     let qd0 = dy
         .initial_qd(0.0, &q0)
         .map_err(|e| Failure::Compute(e.to_string()))?;
-    let mut opts = SimulationOptions::new(integrator, 0.0, t_end, n_out);
-    opts.rtol = rtol;
-    opts.atol = atol;
-    println!("{}", mech.summary());
-    let pb = ProgressBar::new(1000);
-    pb.set_style(
-        ProgressStyle::with_template(
-            "{bar:40} {percent:>3}% t = {msg} s, {elapsed} elapsed, ETA {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let flag = interrupted.clone();
-    let result = dy.simulate(0.0, &q0, &qd0, &opts, |t, _, _| {
-        pb.set_position((1000.0 * t / t_end) as u64);
-        pb.set_message(format!("{t:.4}"));
-        if flag.load(Ordering::SeqCst) {
-            Control::Stop
-        } else {
-            Control::Continue
-        }
-    });
-    pb.finish_and_clear();
-    let traj = result.map_err(|e| Failure::Compute(e.to_string()))?;
-    println!(
-        "{} outputs to t = {:.4} s: {} function evaluations, {} steps ({} rejected), {:.2} s wall time",
-        traj.t.len(),
-        traj.t.last().copied().unwrap_or(0.0),
-        traj.stats.rhs_evals,
-        traj.stats.steps_accepted,
-        traj.stats.steps_rejected,
-        traj.wall_time
-    );
-    std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
-    let table = OutputTable::new(&dy).map_err(|e| Failure::Input(e.to_string()))?;
-    let mut rows = vec![];
-    for ((t, q), qd) in traj.t.iter().zip(&traj.q).zip(&traj.qd) {
-        let mut r = vec![*t];
-        r.extend(
-            table
-                .row(&mut dy, *t, q, qd)
-                .map_err(|e| Failure::Compute(e.to_string()))?,
-        );
-        rows.push(r);
-    }
-    let mut header = vec!["t".to_string()];
-    header.extend(table.header.iter().cloned());
-    let csv = out.join("outputs.csv");
-    let comments = vec![
-        format!("flexmb simulate {}", path.display()),
-        format!(
-            "integrator {integrator:?}, rtol {rtol:e}, atol {atol:e}, {} function evaluations",
-            traj.stats.rhs_evals
-        ),
-    ];
-    write_csv(&csv, &comments, &header, &rows).map_err(|e| io_err(e, &csv))?;
-    let t: Vec<f64> = rows.iter().map(|r| r[0]).collect();
-    let mut plot = Plot::new(&format!("{} — outputs", mech.name), "t (s)", "value (SI)");
-    for (k, h) in table.header.iter().enumerate().take(12) {
-        let y: Vec<f64> = rows.iter().map(|r| r[k + 1]).collect();
-        plot.push(Series::line(h, &t, &y));
-    }
-    let svg = out.join("outputs.svg");
-    plot.save(&svg).map_err(|e| io_err(e, &svg))?;
-    println!("wrote {} and {}", csv.display(), svg.display());
-    // the path of every node whose position is an output (e.g. a manipulator tip)
-    for (k, h) in table.header.iter().enumerate() {
-        if let Some(node) = h.strip_suffix(".x") {
-            if table.header.get(k + 1).map(|n| n.as_str()) == Some(&format!("{node}.y")) {
-                let x: Vec<f64> = rows.iter().map(|r| r[k + 1]).collect();
-                let y: Vec<f64> = rows.iter().map(|r| r[k + 2]).collect();
-                let p = Plot::new(&format!("path of {node}"), "x (m)", "y (m)")
-                    .series(Series::line(node, &x, &y));
-                let f = out.join(format!("path_{node}.svg"));
-                p.save(&f).map_err(|e| io_err(e, &f))?;
-                println!("wrote {}", f.display());
-            }
-        }
-    }
-    if traj.stopped {
-        return Err(Failure::Interrupted);
-    }
-    Ok(())
+    let traj = dy
+        .simulate(0.0, &q0, &qd0, opts, |t, _, _| observer(t))
+        .map_err(|e| Failure::Compute(e.to_string()))?;
+    Ok(Response {
+        t: traj.t,
+        q: traj.q,
+        qd: traj.qd,
+        stats: traj.stats,
+        wall_time: traj.wall_time,
+        stopped: traj.stopped,
+    })
 }
 
 fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), Failure> {
@@ -453,31 +434,21 @@ fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), 
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
-fn sweep(
-    path: &Path,
-    over: &str,
-    from: f64,
-    to: f64,
-    n: usize,
-    k: usize,
-    out: &Path,
-) -> Result<(), Failure> {
-    if n < 1 || !from.is_finite() || !to.is_finite() {
+/// `flexmb sweep`: eigenfrequencies at static equilibria along a load scale
+/// or a held coordinate (unreduced), or along a load scale (reduced model).
+fn sweep(a: &SweepArgs) -> Result<(), Failure> {
+    let (over, n, k) = (a.over.as_str(), a.n, a.modes);
+    if n < 1 || !a.from.is_finite() || !a.to.is_finite() || !a.t_load.is_finite() {
         return Err(Failure::Input(
-            "--n must be ≥ 1 and --from/--to finite".into(),
+            "--n must be ≥ 1 and --from/--to/--t-load finite".into(),
         ));
     }
+    let values = linspace(a.from, a.to, n);
+    if let Some(model) = &a.reduced {
+        return reduced::sweep(a, model, &values);
+    }
+    let path = a.scene.as_path();
     let mut scene = Scene::load(path).map_err(|e| Failure::Input(e.to_string()))?;
-    let values: Vec<f64> = (0..n)
-        .map(|i| {
-            if n == 1 {
-                from
-            } else {
-                from + (to - from) * i as f64 / (n - 1) as f64
-            }
-        })
-        .collect();
     let (mech, param) = if over == "load" {
         let mech = scene
             .build(path.parent())
@@ -488,48 +459,16 @@ fn sweep(
         let probe = scene
             .build(path.parent())
             .map_err(|e| Failure::Input(e.to_string()))?;
-        let select = if let Some(i) = probe.x_names.iter().position(|x| x == over) {
-            let _ = i;
-            let (node, comp) = over
-                .rsplit_once('.')
-                .ok_or_else(|| Failure::Input(format!("bad coordinate '{over}'")))?;
-            let c = match comp {
-                "x" => flexmb_model::Component::X,
-                "y" => flexmb_model::Component::Y,
-                "z" => flexmb_model::Component::Z,
-                "angle" => flexmb_model::Component::Angle,
-                l if l.starts_with('l') => flexmb_model::Component::Lambda(
-                    l[1..]
-                        .parse()
-                        .map_err(|_| Failure::Input(format!("bad coordinate '{over}'")))?,
-                ),
-                _ => return Err(Failure::Input(format!("bad coordinate '{over}'"))),
-            };
-            flexmb_model::Select::Coord(node.to_string(), c)
-        } else if let Some(j) = probe.eps_names.iter().position(|x| x == over) {
-            let e = probe
-                .elements
-                .iter()
-                .find(|e| e.eps_offset <= j && j < e.eps_offset + e.element.n_eps())
-                .expect("owner");
-            flexmb_model::Select::Def(
-                e.id.clone(),
-                e.element.deformation_names()[j - e.eps_offset].clone(),
-            )
-        } else {
-            return Err(Failure::Input(format!("'{over}' is neither `load` nor a coordinate or deformation of the scene (see `flexmb info`)")));
-        };
+        let select = coords::selection(&probe, over)?.ok_or_else(|| {
+            Failure::Input(format!("'{over}' is neither `load` nor a coordinate or deformation of the scene (see `flexmb info`)"))
+        })?;
         scene.dofs_first.insert(0, select);
         let mech = Arc::new(
             scene
                 .build(path.parent())
                 .map_err(|e| Failure::Input(e.to_string()))?,
         );
-        let k = mech
-            .dofs
-            .iter()
-            .position(|c| mech.coordinate_name(*c) == over)
-            .expect("first DOF");
+        let k = coords::dof_index(&mech, over, "--over")?;
         // the sweep parameter is the change from the reference configuration
         let q_ref = mech.q0()[k];
         let param = flexmb_linearize::SweepParameter::Path {
@@ -539,17 +478,12 @@ fn sweep(
         (mech, param)
     };
     println!("{}", mech.summary());
-    let pb = ProgressBar::new(2 * n as u64);
-    pb.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} {elapsed} elapsed, ETA {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    pb.set_message("equilibria, then eigen analyses");
+    let pb = count_bar(2 * n as u64, "equilibria, then eigen analyses");
     let start = std::time::Instant::now();
     let opts = flexmb_linearize::SweepOptions {
         values,
         modes: k,
-        t: 0.0,
+        t: a.t_load,
         keep_vectors: false,
     };
     let pts = flexmb_linearize::sweep(&mech, &param, &opts, &|d, _| pb.set_position(d as u64))
@@ -557,53 +491,46 @@ fn sweep(
     pb.finish_and_clear();
     let wall = start.elapsed().as_secs_f64();
     println!("{n} configurations, {k} modes each, in {wall:.2} s");
-    std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
-    let mut header = vec![if over == "load" {
+    let sw = FrequencySweep {
+        title: &mech.name,
+        parameter: sweep_parameter_name(over),
+        s: pts.iter().map(|p| p.s).collect(),
+        frequencies: pts.iter().map(|p| p.frequencies_hz.clone()).collect(),
+        modes: k,
+    };
+    let comments = [
+        sweep_command_line(a),
+        "undamped eigenfrequencies at static equilibria (rest linearization, thesis (E.6))".into(),
+    ];
+    write_frequency_sweep(&sw, &comments, &a.out)
+}
+
+/// The CSV column of a sweep parameter: `load_scale` or `NAME change`.
+fn sweep_parameter_name(over: &str) -> String {
+    if over == "load" {
         "load_scale".to_string()
     } else {
         format!("{over} change")
-    }];
-    header.extend((1..=k).map(|i| format!("f{i}_hz")));
-    let rows: Vec<Vec<f64>> = pts
-        .iter()
-        .map(|p| {
-            std::iter::once(p.s)
-                .chain(p.frequencies_hz.iter().copied())
-                .collect()
-        })
-        .collect();
-    let csv = out.join("eigenfrequencies.csv");
-    write_csv(
-        &csv,
-        &[
-            format!(
-                "flexmb sweep {} --over {over} --from {from} --to {to} --n {n} --modes {k}",
-                path.display()
-            ),
-            "undamped eigenfrequencies at static equilibria (rest linearization, thesis (E.6))"
-                .into(),
-        ],
-        &header,
-        &rows,
-    )
-    .map_err(|e| io_err(e, &csv))?;
-    let mut plot = Plot::new(
-        &format!("{}: eigenfrequencies", mech.name),
-        over,
-        "frequency (Hz)",
-    );
-    let s: Vec<f64> = rows.iter().map(|r| r[0]).collect();
-    for i in 0..k {
-        let f: Vec<f64> = rows
-            .iter()
-            .map(|r| r.get(i + 1).copied().unwrap_or(f64::NAN))
-            .collect();
-        plot.push(Series::line(&format!("ω{}", i + 1), &s, &f));
     }
-    let svg = out.join("eigenfrequencies.svg");
-    plot.save(&svg).map_err(|e| io_err(e, &svg))?;
-    println!("wrote {} and {}", csv.display(), svg.display());
-    Ok(())
+}
+
+/// The command line of a sweep, for the CSV header.
+fn sweep_command_line(a: &SweepArgs) -> String {
+    let reduced = a
+        .reduced
+        .as_ref()
+        .map(|m| format!(" --reduced {}", m.display()))
+        .unwrap_or_default();
+    format!(
+        "flexmb sweep {}{reduced} --over {} --from {} --to {} --n {} --modes {} --t-load {}",
+        a.scene.display(),
+        a.over,
+        a.from,
+        a.to,
+        a.n,
+        a.modes,
+        a.t_load
+    )
 }
 
 fn build_superelement(spec_path: &Path) -> Result<(), Failure> {

@@ -42,7 +42,7 @@ fn sigint_stops_a_simulation_with_partial_results_and_exit_130() {
     let csv = std::fs::read_to_string(out.join("outputs.csv")).expect("partial outputs written");
     let rows = csv.lines().filter(|l| !l.starts_with('#')).count() - 1;
     assert!(
-        rows >= 1 && rows < 2001,
+        (1..2001).contains(&rows),
         "{rows} output rows: partial, not empty and not all"
     );
     let _ = std::fs::remove_dir_all(&out);

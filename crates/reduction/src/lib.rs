@@ -13,8 +13,10 @@
 //! (5.22)–(5.23) bases, and the interpolated basis method (6.23) with cubic
 //! splines and modal subspace interpolation (§6.3.3) or MAC-sorted
 //! eigenvectors, the per-mode SVD (6.19)–(6.21), the path eigenvectors of
-//! chapter 7 (7.3)–(7.11), reduced statics, the reduced linearization (F.5)
-//! with its rest form (F.7), and saving and loading reduced models.
+//! chapter 7 (7.3)–(7.11), reduced statics with load-scale continuation
+//! ([`load_scale_path`]), the reduced linearization (F.5) with its rest form
+//! (F.7), and saving and loading reduced models ([`SavedModel`]). The
+//! `flexmb reduce` command builds these models from a scene (docs/cli.md).
 //!
 //! ```
 //! use flexmb_reduction::{FixedBasis, ReducedModel};
@@ -32,6 +34,7 @@
 #![warn(missing_docs)]
 
 mod basis;
+mod continuation;
 mod ibm;
 mod model;
 mod msi;
@@ -41,8 +44,9 @@ mod spline;
 
 pub use basis::{
     fixed_basis_frequencies, modal_basis, per_mode_svd_basis, svd_modal_basis, Basis, FixedBasis,
-    PerModeSvd, SvdModal,
+    PerModeSvd, SvdModal, FINAL_SVD_THRESHOLD, SVD_THRESHOLD,
 };
+pub use continuation::{continue_load_scale, load_scale_path, SUBSTEPS};
 pub use ibm::{interpolated_basis_from_sweep, InterpolatedBasis, Knots, SubspaceInterpolation};
 pub use model::{ReducedLinearization, ReducedModel, ReducedTrajectory};
 pub use msi::{largest_principal_angle, mac_sorted, modal_subspace_interpolation, orthonormalize};
@@ -64,6 +68,20 @@ pub enum ReductionError {
     /// Inconsistent input.
     #[error("{0}")]
     Invalid(String),
+    /// No static equilibrium was found along a load-scale continuation.
+    #[error(
+        "no equilibrium at load scale {lambda:.4} (from {from:.4}, {substeps} substeps): {message}"
+    )]
+    NoEquilibrium {
+        /// The load scale that could not be reached.
+        lambda: f64,
+        /// The load scale of the last equilibrium.
+        from: f64,
+        /// The most substeps tried.
+        substeps: usize,
+        /// The solver's last message.
+        message: String,
+    },
     /// The reduced mass matrix is singular (dependent basis vectors).
     #[error("the reduced mass matrix is not positive definite: the basis vectors are linearly dependent or carry no inertia")]
     SingularMass,

@@ -65,6 +65,55 @@ impl ReducedModel {
         self.q.clone()
     }
 
+    /// q = G(z) and q̇ = G,z ż: the unreduced state of a reduced state, e.g.
+    /// to record the scene's outputs along a reduced trajectory.
+    pub fn full_state(&mut self, z: &[f64], zd: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        self.basis
+            .eval(z, zd, &mut self.q, &mut self.gz, &mut self.conv);
+        let qd = (0..self.q.len())
+            .map(|i| (0..zd.len()).map(|k| self.gz[(i, k)] * zd[k]).sum())
+            .collect();
+        (self.q.clone(), qd)
+    }
+
+    /// The reduced velocities ż whose q̇ = G,z ż is closest to `qd` in the
+    /// kinetic-energy norm at q = G(z): ż = Mz⁻¹ G,zᵀ Mq q̇ with
+    /// Mz = G,zᵀ Mq G,z (exact when `qd` lies in the range of G,z, zero for
+    /// `qd` = 0). Starts a reduced model from the scene's initial velocities.
+    pub fn project_velocities(
+        &mut self,
+        t: f64,
+        z: &[f64],
+        qd: &[f64],
+    ) -> Result<Vec<f64>, ReductionError> {
+        let nz = self.basis.n_z();
+        if z.len() != nz || qd.len() != self.basis.n_q() {
+            return Err(ReductionError::Invalid(format!(
+                "velocity projection: {} reduced and {} full coordinates for a {nz} × {} basis",
+                z.len(),
+                qd.len(),
+                self.basis.n_q()
+            )));
+        }
+        if qd.iter().all(|v| *v == 0.0) {
+            return Ok(vec![0.0; nz]);
+        }
+        self.basis
+            .eval(z, &vec![0.0; nz], &mut self.q, &mut self.gz, &mut self.conv);
+        let zero = vec![0.0; qd.len()];
+        let (mq, _) = self.dy.mass_and_force(t, &self.q, &zero)?;
+        let mq = mq.to_owned();
+        let mg = &mq * &self.gz;
+        let mz = self.gz.transpose() * &mg;
+        let mut b = Mat::from_fn(nz, 1, |k, _| {
+            (0..qd.len()).map(|i| mg[(i, k)] * qd[i]).sum::<f64>()
+        });
+        mz.llt(faer::Side::Lower)
+            .map_err(|_| ReductionError::SingularMass)?
+            .solve_in_place(b.as_mut());
+        Ok((0..nz).map(|k| b[(k, 0)]).collect())
+    }
+
     /// z̈ from (6.15): Mz z̈ = G,zᵀ(rhs_q − Mq (G,zz ż)ż), Mz = G,zᵀ Mq G,z.
     pub fn accelerations(
         &mut self,
@@ -269,36 +318,29 @@ impl ReducedModel {
         zd: &[f64],
         zdd: &[f64],
     ) -> Result<Vec<f64>, ReductionError> {
-        let (q, qd, qdd) = self.full_state(z, zd, zdd);
+        let (q, qd, qdd) = self.full_motion(z, zd, zdd);
         let mut g = vec![0.0; q.len()];
         self.dy.residual(t, &q, &qd, &qdd, &mut g)?;
         Ok(self.project(&g))
     }
 
-    /// q, q̇ and q̈ of a reduced state ((6.13)).
-    fn full_state(&mut self, z: &[f64], zd: &[f64], zdd: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-        self.basis
-            .eval(z, zd, &mut self.q, &mut self.gz, &mut self.conv);
-        let nq = self.q.len();
-        let qd: Vec<f64> = (0..nq)
-            .map(|i| {
-                zd.iter()
-                    .enumerate()
-                    .map(|(k, v)| self.gz[(i, k)] * v)
-                    .sum()
-            })
-            .collect();
-        let qdd: Vec<f64> = (0..nq)
+    /// q, q̇ and q̈ = G,z z̈ + (G,zz ż)ż of a reduced state ((6.13)).
+    fn full_motion(
+        &mut self,
+        z: &[f64],
+        zd: &[f64],
+        zdd: &[f64],
+    ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (q, qd) = self.full_state(z, zd);
+        let qdd: Vec<f64> = (0..q.len())
             .map(|i| {
                 self.conv[i]
-                    + zdd
-                        .iter()
-                        .enumerate()
-                        .map(|(k, v)| self.gz[(i, k)] * v)
+                    + (0..zdd.len())
+                        .map(|k| self.gz[(i, k)] * zdd[k])
                         .sum::<f64>()
             })
             .collect();
-        (self.q.clone(), qd, qdd)
+        (q, qd, qdd)
     }
 
     /// G,zᵀ v.
@@ -325,7 +367,7 @@ impl ReducedModel {
         zd: &[f64],
         zdd: &[f64],
     ) -> Result<ReducedLinearization, ReductionError> {
-        let (q, qd, qdd) = self.full_state(z, zd, zdd);
+        let (q, qd, qdd) = self.full_motion(z, zd, zdd);
         let mut g = vec![0.0; q.len()];
         self.dy.residual(t, &q, &qd, &qdd, &mut g)?;
         let lin = self.dy.linearize(t, &q, &qd, &qdd)?;

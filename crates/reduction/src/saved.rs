@@ -139,12 +139,27 @@ impl SavedModel {
                 .zip(&self.dofs)
                 .position(|(a, b)| a != b)
                 .unwrap_or(names.len().min(self.dofs.len()));
+            let name = |v: &[String]| {
+                v.get(first)
+                    .map(|n| format!("`{n}`"))
+                    .unwrap_or_else(|| "absent".into())
+            };
             return Err(ReductionError::Invalid(format!(
-                "the reduced model was built for other degrees of freedom ({} saved, {} in the scene; first difference at #{first}: saved {:?}, scene {:?}); rebuild it from this scene",
+                "the reduced model was built for other degrees of freedom: DOF {} is {} in the model and {} in the scene (the model has {} DOFs, the scene {}); rebuild the model from this scene",
+                first + 1,
+                name(&self.dofs),
+                name(&names),
                 self.dofs.len(),
                 names.len(),
-                self.dofs.get(first),
-                names.get(first)
+            )));
+        }
+        let n_q = names.len();
+        let q0_len = match &self.basis {
+            SavedBasis::Fixed { q0, .. } | SavedBasis::Interpolated { q0, .. } => q0.len(),
+        };
+        if q0_len != n_q {
+            return Err(ReductionError::Invalid(format!(
+                "the model lists {n_q} DOFs but its offset q0 has {q0_len} values"
             )));
         }
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());

@@ -136,3 +136,31 @@ fn svd_modal_basis_from_ten_configurations() {
         assert!((3..=10).contains(&kept), "{kept}");
     }
 }
+
+#[test]
+fn full_state_and_velocity_projection_invert_each_other_on_the_basis() {
+    let mech = planar_guidance();
+    let b = modal_basis(&mech, 0.0, &mech.q0(), 3, None).unwrap();
+    let v = b.v.clone();
+    let mut red = ReducedModel::new(mech.clone(), Box::new(b));
+    let (z, zd) = ([0.01, -0.002, 0.003], [0.5, 0.2, -0.1]);
+    let (q, qd) = red.full_state(&z, &zd);
+    for i in 0..q.len() {
+        let vz: f64 = (0..3).map(|k| v[(i, k)] * z[k]).sum();
+        let vzd: f64 = (0..3).map(|k| v[(i, k)] * zd[k]).sum();
+        assert!((q[i] - mech.q0()[i] - vz).abs() < 1e-15);
+        assert!((qd[i] - vzd).abs() < 1e-15);
+    }
+    // q̇ in the range of G,z is projected back exactly; q̇ = 0 gives ż = 0
+    let back = red.project_velocities(0.0, &z, &qd).unwrap();
+    for k in 0..3 {
+        assert!((back[k] - zd[k]).abs() < 1e-10 * zd[k].abs(), "{back:?}");
+    }
+    let zero = red
+        .project_velocities(0.0, &z, &vec![0.0; q.len()])
+        .unwrap();
+    assert_eq!(zero, vec![0.0; 3]);
+    // a coordinate listed twice as large is refused
+    let e = modal_basis(&mech, 0.0, &mech.q0(), 2, Some(&[1, 1])).unwrap_err();
+    assert!(e.to_string().contains("listed twice"), "{e}");
+}

@@ -1,0 +1,181 @@
+//! What the commands write, shared by unreduced and reduced models: the time
+//! response table (`outputs.csv`/`.svg`, node paths), the eigenfrequency
+//! sweep (`eigenfrequencies.csv`/`.svg`) and progress bars.
+
+use crate::{io_err, Failure};
+use flexmb_dynamics::{Dynamics, OutputTable, Stats};
+use flexmb_plot::{write_csv, Plot, Series};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::Path;
+
+/// `n` equidistant values from `from` to `to` (`from` alone when n = 1).
+pub(crate) fn linspace(from: f64, to: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| {
+            if n == 1 {
+                from
+            } else {
+                from + (to - from) * i as f64 / (n - 1) as f64
+            }
+        })
+        .collect()
+}
+
+/// A progress bar over `len` items: equilibria, then eigen analyses.
+pub(crate) fn count_bar(len: u64, message: &str) -> ProgressBar {
+    let pb = ProgressBar::new(len);
+    pb.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} {elapsed} elapsed, ETA {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    pb.set_message(message.to_string());
+    pb
+}
+
+/// A progress bar over simulated time (per mille of the end time).
+pub(crate) fn time_bar() -> ProgressBar {
+    let pb = ProgressBar::new(1000);
+    pb.set_style(
+        ProgressStyle::with_template(
+            "{bar:40} {percent:>3}% t = {msg} s, {elapsed} elapsed, ETA {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    pb
+}
+
+/// A time response in the unreduced coordinates (a reduced one mapped by
+/// q = G(z), q̇ = G,z ż) and what it cost.
+pub(crate) struct Response {
+    /// Output times.
+    pub t: Vec<f64>,
+    /// q at each output time.
+    pub q: Vec<Vec<f64>>,
+    /// q̇ at each output time.
+    pub qd: Vec<Vec<f64>>,
+    /// The integrator's statistics.
+    pub stats: Stats,
+    /// Wall time of the integration (s).
+    pub wall_time: f64,
+    /// Stopped early (Ctrl-C).
+    pub stopped: bool,
+}
+
+impl Response {
+    /// The line `flexmb simulate` prints: outputs, evaluations, steps, time.
+    pub(crate) fn summary(&self) -> String {
+        format!(
+            "{} outputs to t = {:.4} s: {} function evaluations, {} steps ({} rejected), {:.2} s wall time",
+            self.t.len(),
+            self.t.last().copied().unwrap_or(0.0),
+            self.stats.rhs_evals,
+            self.stats.steps_accepted,
+            self.stats.steps_rejected,
+            self.wall_time
+        )
+    }
+}
+
+/// Writes `out/outputs.csv` (the scene's outputs, or the DOFs, at each output
+/// time), `out/outputs.svg` (the first twelve columns) and `out/path_N.svg`
+/// for every node N whose x and y are outputs.
+pub(crate) fn write_outputs(
+    dy: &mut Dynamics,
+    r: &Response,
+    comments: &[String],
+    out: &Path,
+) -> Result<(), Failure> {
+    std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
+    let table = OutputTable::new(dy).map_err(|e| Failure::Input(e.to_string()))?;
+    let mut rows = vec![];
+    for ((t, q), qd) in r.t.iter().zip(&r.q).zip(&r.qd) {
+        let mut row = vec![*t];
+        row.extend(
+            table
+                .row(dy, *t, q, qd)
+                .map_err(|e| Failure::Compute(e.to_string()))?,
+        );
+        rows.push(row);
+    }
+    let mut header = vec!["t".to_string()];
+    header.extend(table.header.iter().cloned());
+    let csv = out.join("outputs.csv");
+    write_csv(&csv, comments, &header, &rows).map_err(|e| io_err(e, &csv))?;
+    let t: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+    let name = &dy.mechanism().name;
+    let mut plot = Plot::new(&format!("{name} — outputs"), "t (s)", "value (SI)");
+    for (k, h) in table.header.iter().enumerate().take(12) {
+        let y: Vec<f64> = rows.iter().map(|r| r[k + 1]).collect();
+        plot.push(Series::line(h, &t, &y));
+    }
+    let svg = out.join("outputs.svg");
+    plot.save(&svg).map_err(|e| io_err(e, &svg))?;
+    println!("wrote {} and {}", csv.display(), svg.display());
+    // the path of every node whose position is an output (e.g. a manipulator tip)
+    for (k, h) in table.header.iter().enumerate() {
+        if let Some(node) = h.strip_suffix(".x") {
+            if table.header.get(k + 1).map(|n| n.as_str()) == Some(&format!("{node}.y")) {
+                let x: Vec<f64> = rows.iter().map(|r| r[k + 1]).collect();
+                let y: Vec<f64> = rows.iter().map(|r| r[k + 2]).collect();
+                let p = Plot::new(&format!("path of {node}"), "x (m)", "y (m)")
+                    .series(Series::line(node, &x, &y));
+                let f = out.join(format!("path_{node}.svg"));
+                p.save(&f).map_err(|e| io_err(e, &f))?;
+                println!("wrote {}", f.display());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// An eigenfrequency sweep: the parameter and the frequencies (Hz) at each
+/// configuration.
+pub(crate) struct FrequencySweep<'a> {
+    /// Title of the plot (the mechanism or model).
+    pub title: &'a str,
+    /// The CSV column and plot axis of the parameter (`load_scale`,
+    /// `S.x change`).
+    pub parameter: String,
+    /// The parameter values.
+    pub s: Vec<f64>,
+    /// The frequencies at each value (`modes` of them).
+    pub frequencies: Vec<Vec<f64>>,
+    /// Number of modes (columns).
+    pub modes: usize,
+}
+
+/// Writes `out/eigenfrequencies.csv` (the parameter, f1_hz … fk_hz) and
+/// `out/eigenfrequencies.svg`.
+pub(crate) fn write_frequency_sweep(
+    sw: &FrequencySweep,
+    comments: &[String],
+    out: &Path,
+) -> Result<(), Failure> {
+    std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
+    let mut header = vec![sw.parameter.clone()];
+    header.extend((1..=sw.modes).map(|i| format!("f{i}_hz")));
+    let rows: Vec<Vec<f64>> =
+        sw.s.iter()
+            .zip(&sw.frequencies)
+            .map(|(s, f)| {
+                std::iter::once(*s)
+                    .chain((0..sw.modes).map(|i| f.get(i).copied().unwrap_or(f64::NAN)))
+                    .collect()
+            })
+            .collect();
+    let csv = out.join("eigenfrequencies.csv");
+    write_csv(&csv, comments, &header, &rows).map_err(|e| io_err(e, &csv))?;
+    let mut plot = Plot::new(
+        &format!("{}: eigenfrequencies", sw.title),
+        &sw.parameter,
+        "frequency (Hz)",
+    );
+    for i in 0..sw.modes {
+        let f: Vec<f64> = rows.iter().map(|r| r[i + 1]).collect();
+        plot.push(Series::line(&format!("ω{}", i + 1), &sw.s, &f));
+    }
+    let svg = out.join("eigenfrequencies.svg");
+    plot.save(&svg).map_err(|e| io_err(e, &svg))?;
+    println!("wrote {} and {}", csv.display(), svg.display());
+    Ok(())
+}
