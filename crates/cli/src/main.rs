@@ -4,6 +4,7 @@
 //! options), 130 interrupted (partial results are written).
 
 mod coords;
+mod path;
 mod reduce;
 mod reduced;
 mod report;
@@ -121,9 +122,10 @@ struct SimulateArgs {
 struct SweepArgs {
     /// Scene file (RON).
     scene: PathBuf,
-    /// `load` (scale the scene's loads) or a coordinate/deformation name
-    /// such as `S.x` or `flexure1.3.bending_z_p` (`flexmb info` lists them);
-    /// a coordinate is swept as its change from the reference configuration.
+    /// `load` (scale the scene's loads), a coordinate/deformation name such
+    /// as `S.x` or `flexure1.3.bending_z_p` (`flexmb info` lists them; swept
+    /// as its change from the reference configuration), or `path` (several
+    /// coordinates along the path of --path, s from --from to --to).
     /// With --reduced: `load` only.
     #[arg(long)]
     over: String,
@@ -143,6 +145,11 @@ struct SweepArgs {
     /// them: pick a time where they act, e.g. the peak of a pulse).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     t_load: f64,
+    /// With `--over path`: a CSV file `s,NAME,...` giving each coordinate's
+    /// change from the reference configuration as a function of s (linear
+    /// between rows); the path P(s) of thesis (4.1).
+    #[arg(long, value_name = "PATH.csv")]
+    path: Option<PathBuf>,
     /// Sweep this reduced model of the scene (written by `flexmb reduce`):
     /// reduced static equilibria by continuation from load scale 0, reduced
     /// eigenfrequencies (F.7) at each.
@@ -449,11 +456,36 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
     }
     let path = a.scene.as_path();
     let mut scene = Scene::load(path).map_err(|e| Failure::Input(e.to_string()))?;
+    if a.path.is_some() && over != "path" {
+        return Err(Failure::Input("--path needs `--over path`".into()));
+    }
     let (mech, param) = if over == "load" {
         let mech = scene
             .build(path.parent())
             .map_err(|e| Failure::Input(e.to_string()))?;
         (Arc::new(mech), flexmb_linearize::SweepParameter::LoadScale)
+    } else if over == "path" {
+        let file = a
+            .path
+            .as_ref()
+            .ok_or_else(|| Failure::Input("`--over path` needs --path PATH.csv".into()))?;
+        let p = crate::path::TabulatedPath::read(file)?;
+        let (lo, hi) = p.range();
+        if a.from.min(a.to) < lo || a.from.max(a.to) > hi {
+            return Err(Failure::Input(format!(
+                "--from {} --to {} leaves the path's range of s [{lo}, {hi}] in {}",
+                a.from,
+                a.to,
+                file.display()
+            )));
+        }
+        let (mech, ks) = p.mechanism(&mut scene, path.parent())?;
+        let q_ref: Vec<f64> = ks.iter().map(|k| mech.q0()[*k]).collect();
+        let param = flexmb_linearize::SweepParameter::Path {
+            dofs: ks,
+            path: Box::new(move |s| p.at(s).iter().zip(&q_ref).map(|(d, r)| r + d).collect()),
+        };
+        (Arc::new(mech), param)
     } else {
         // make the coordinate a degree of freedom, then hold it
         let probe = scene
@@ -509,6 +541,8 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
 fn sweep_parameter_name(over: &str) -> String {
     if over == "load" {
         "load_scale".to_string()
+    } else if over == "path" {
+        "s".to_string()
     } else {
         format!("{over} change")
     }
