@@ -102,7 +102,8 @@ fn nice_step(range: f64, n: usize) -> f64 {
 }
 
 fn fmt_tick(v: f64, step: f64) -> String {
-    if v == 0.0 {
+    // ticks are multiples of the step: rounding residue of zero is zero
+    if v == 0.0 || v.abs() < 1e-9 * step.abs() {
         return "0".into();
     }
     let a = v.abs();
@@ -372,6 +373,13 @@ pub fn read_csv(path: &Path) -> io::Result<(Vec<String>, Vec<Vec<f64>>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tick_at_rounding_distance_from_zero_is_zero() {
+        assert_eq!(fmt_tick(-5.551115123125783e-17, 0.05), "0");
+        assert_eq!(fmt_tick(0.05, 0.05), "0.05");
+        assert_eq!(fmt_tick(-2e-4, 1e-4), "-2.0e-4");
+    }
 
     #[test]
     fn csv_round_trips_and_svg_has_every_series() {
