@@ -392,7 +392,8 @@ fn write(
     for (r, f) in [mu, mr].iter().zip(&freq_t) {
         for k in 0..2 {
             let y: Vec<f64> = f.iter().map(|v| v[k]).collect();
-            let label = format!("{} ω{}", r.model.name, k + 1);
+            let short = r.model.name.trim_start_matches("Manipulator ");
+            let label = format!("{short} ω{}", k + 1);
             p.push(if r.model.name.contains("unreduced") {
                 Series::line(&label, &tt, &y)
             } else {

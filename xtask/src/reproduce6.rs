@@ -227,13 +227,19 @@ fn write_outputs(
         3,
     )?;
     // singular values (Figs 6.7, 6.8)
-    let sv = |file: &str, title: &str, v: &[f64]| -> std::io::Result<()> {
+    // the selection rule drawn as a line: 1 % per mode, FINAL_SVD_THRESHOLD for step 9
+    let sv = |file: &str, title: &str, v: &[f64], rule: f64| -> std::io::Result<()> {
         let k: Vec<f64> = (1..=v.len()).map(|i| i as f64).collect();
         let pc: Vec<f64> = v.iter().map(|x| 100.0 * x).collect();
+        let label = format!("{} % (kept above)", 100.0 * rule);
         Plot::new(title, "singular vector", "singular value (% of the sum)")
             .log_y()
             .series(Series::points("singular values", &k, &pc))
-            .series(Series::dashed("1 %", &[1.0, v.len() as f64], &[1.0, 1.0]))
+            .series(Series::dashed(
+                &label,
+                &[1.0, v.len() as f64],
+                &[100.0 * rule; 2],
+            ))
             .save(&out.join(file))
     };
     for (j, rel, _) in &models.svd13.per_mode {
@@ -246,17 +252,20 @@ fn write_outputs(
                 opts.n_ref
             ),
             &rel[..n],
+            flexmb_reduction::SVD_THRESHOLD,
         )?;
     }
     sv(
         "fig6_8a_svd7_singular_values.svg",
         "Fig. 6.8a: SVD of the collected vectors, SVD-7",
         &models.svd7.final_relative,
+        flexmb_reduction::FINAL_SVD_THRESHOLD,
     )?;
     sv(
         "fig6_8b_svd13_singular_values.svg",
         "Fig. 6.8b: SVD of the collected vectors, SVD-13",
         &models.svd13.final_relative,
+        flexmb_reduction::FINAL_SVD_THRESHOLD,
     )?;
     // responses
     let run = |n: &str| runs.iter().find(|r| r.name == n);
@@ -364,7 +373,7 @@ fn write_outputs(
     let _ = writeln!(s, "* The thesis does not state the simulated time; {} s covers the pulse, the first maximum and the swing to the opposite side (Fig. 6.6).", opts.t_end);
     let _ = writeln!(s, "* Reduced bases from {} reference configurations without gravity (MSI-7g: with), as in §6.4.1: FBM from equilibria under a static x-force at S (λ up to ±{:.4} × 100 N, which holds S at ±{} m), with deformation coordinates as DOFs; IBM from equilibria with the x of S held at {} evenly spaced values in ±{} m, with absolute nodal coordinates as DOFs. Sweeps and model building took {:.1} s (sweeps {:.1} s).", opts.n_ref, setup.lambda_max, opts.x_max, opts.n_ref, opts.x_max, build_time, refs.wall_time);
     let _ = writeln!(s, "* Eigenfrequency curves (Figs 6.9, 6.10, 6.12, 6.13): each model's undamped eigenfrequencies of the rest linearization ((E.6), reduced (F.7)) at its own static equilibrium under gravity and a static x-force at S, λ ∈ [−{0:.4}, {0:.4}] ({1} points), against its own x-displacement. The thesis evaluates them at states of the time response between the dashed lines of Fig. 6.6; static equilibria make the curves independent of the integrator and let CI compare them (`fixtures/curves/ch6`).", setup.lambda_max, opts.n_curve);
-    let _ = writeln!(s, "* SVD selection: 1 % per mode (steps 5–6 of §6.3.2) gives {} and {} vectors for modes 1 and 2 (SVD-7: {} after the last SVD) and {} and {} for modes 3 and 4 (collection of {}, SVD-13: {}); see `FINAL_THRESHOLD` for the last SVD's rule.\n",
+    let _ = writeln!(s, "* SVD selection: 1 % per mode (steps 5–6 of §6.3.2) gives {} and {} vectors for modes 1 and 2 (SVD-7: {} after the last SVD) and {} and {} for modes 3 and 4 (collection of {}, SVD-13: {}); see `flexmb_reduction::FINAL_SVD_THRESHOLD` for the last SVD's rule.\n",
         models.svd13.per_mode[0].2, models.svd13.per_mode[1].2, models.svd7.basis.v.ncols(), models.svd13.per_mode[2].2, models.svd13.per_mode[3].2,
         models.svd13.per_mode.iter().map(|p| p.2).sum::<usize>(), models.svd13.basis.v.ncols());
     let _ = writeln!(
