@@ -269,22 +269,22 @@ pub fn models(s: &Setup, r: &References) -> Result<Models, String> {
         Model::new(
             "MSI-2",
             &s.nod,
-            ModelKind::Interpolated(ibm(&r.ibm, 1, Msi)?),
+            ModelKind::Interpolated(Box::new(ibm(&r.ibm, 1, Msi)?)),
         ),
         Model::new(
             "MSI-7",
             &s.nod,
-            ModelKind::Interpolated(ibm(&r.ibm, 6, Msi)?),
+            ModelKind::Interpolated(Box::new(ibm(&r.ibm, 6, Msi)?)),
         ),
         Model::new(
             "MSI-7g",
             &s.nod,
-            ModelKind::Interpolated(ibm(&r.ibm_g, 6, Msi)?),
+            ModelKind::Interpolated(Box::new(ibm(&r.ibm_g, 6, Msi)?)),
         ),
         Model::new(
             "MAC-7",
             &s.nod,
-            ModelKind::Interpolated(ibm(&r.ibm, 6, MacSorted)?),
+            ModelKind::Interpolated(Box::new(ibm(&r.ibm, 6, MacSorted)?)),
         ),
     ];
     Ok(Models {

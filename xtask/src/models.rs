@@ -17,7 +17,7 @@ pub enum ModelKind {
     /// A fixed basis (6.16).
     Fixed(FixedBasis),
     /// An interpolated basis (6.23).
-    Interpolated(InterpolatedBasis),
+    Interpolated(Box<InterpolatedBasis>),
 }
 
 /// A named model of a mechanism.
@@ -46,7 +46,7 @@ impl Model {
         let b: Box<dyn Basis> = match &self.kind {
             ModelKind::Unreduced => return None,
             ModelKind::Fixed(b) => Box::new(b.clone()),
-            ModelKind::Interpolated(b) => Box::new(b.clone()),
+            ModelKind::Interpolated(b) => b.clone(),
         };
         Some(ReducedModel::new(self.mech.clone(), b))
     }

@@ -36,6 +36,22 @@ pub struct InterpolatedBasis {
     v: CubicSpline,
     n_q: usize,
     r: usize,
+    /// Spline work arrays of [`Basis::eval`] (Q and its derivatives, V and
+    /// its derivatives column by column), so that the equations of motion
+    /// do not allocate.
+    work: SplineWork,
+}
+
+/// Work arrays behind a mutex (uncontended: each model evaluates in one
+/// thread), so the basis stays `Sync` for parallel sweeps; a clone starts
+/// with empty arrays.
+#[derive(Debug, Default)]
+struct SplineWork(std::sync::Mutex<[[Vec<f64>; 4]; 2]>);
+
+impl Clone for SplineWork {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 impl InterpolatedBasis {
@@ -108,6 +124,7 @@ impl InterpolatedBasis {
             q: CubicSpline::new(s.clone(), dq)?,
             v: CubicSpline::new(s.clone(), flat)?,
             knots: Knots { s, qs, w },
+            work: SplineWork::default(),
             q0,
             n_q,
             r,
@@ -251,18 +268,26 @@ impl Basis for InterpolatedBasis {
     fn eval(&self, z: &[f64], zd: &[f64], q: &mut [f64], gz: &mut Mat<f64>, conv: &mut [f64]) {
         let (s, eta) = (z[0], &z[1..]);
         let (sd, etad) = (zd[0], &zd[1..]);
-        let mut wq = self.q.work();
-        self.q.eval(s, &mut wq);
-        let v = self.v_and_derivatives(s);
-        for i in 0..self.n_q {
+        let mut work = self.work.0.lock().unwrap_or_else(|p| p.into_inner());
+        let [wq, wv] = &mut *work;
+        if wq[0].len() != self.n_q {
+            *wq = self.q.work();
+            *wv = self.v.work();
+        }
+        self.q.eval(s, wq);
+        self.v.eval(s, wv);
+        // V's derivative o, entry (i, j), is wv[o][j n_q + i]
+        let n = self.n_q;
+        for i in 0..n {
             let (mut val, mut d1, mut d2, mut d1e) =
                 (self.q0[i] + wq[0][i], wq[1][i], wq[2][i], 0.0);
             for j in 0..self.r {
-                val += v[0][(i, j)] * eta[j];
-                d1 += v[1][(i, j)] * eta[j];
-                d2 += v[2][(i, j)] * eta[j];
-                d1e += v[1][(i, j)] * etad[j];
-                gz[(i, 1 + j)] = v[0][(i, j)];
+                let c = j * n + i;
+                val += wv[0][c] * eta[j];
+                d1 += wv[1][c] * eta[j];
+                d2 += wv[2][c] * eta[j];
+                d1e += wv[1][c] * etad[j];
+                gz[(i, 1 + j)] = wv[0][c];
             }
             q[i] = val;
             gz[(i, 0)] = d1;
