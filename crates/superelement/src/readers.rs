@@ -100,21 +100,7 @@ pub fn parse_matrix_market(text: &str, file: &str) -> Result<SparseColMat<usize,
                 trip.reserve(p(f[2])?);
             }
             Some((nr, nc, _)) => {
-                if f.len() != 3 {
-                    return Err(Error::parse(
-                        file,
-                        ln + 1,
-                        format!("expected 'row col value', got '{t}'"),
-                    ));
-                }
-                let i: usize = f[0]
-                    .parse()
-                    .map_err(|_| Error::parse(file, ln + 1, format!("bad row index '{}'", f[0])))?;
-                let j: usize = f[1].parse().map_err(|_| {
-                    Error::parse(file, ln + 1, format!("bad column index '{}'", f[1]))
-                })?;
-                let v: f64 = parse_f64(f[2])
-                    .ok_or_else(|| Error::parse(file, ln + 1, format!("bad value '{}'", f[2])))?;
+                let (i, j, v) = parse_triplet(&f, t, file, ln + 1)?;
                 if i == 0 || j == 0 || i > nr || j > nc {
                     return Err(Error::parse(
                         file,
@@ -145,6 +131,32 @@ pub fn parse_matrix_market(text: &str, file: &str) -> Result<SparseColMat<usize,
         ));
     }
     to_csc(nr, nc, trip, file)
+}
+
+/// One `row col value` line (1-based indices, not yet range-checked), as
+/// Matrix Market coordinate entries and CalculiX `.sti`/`.mas` files hold them.
+fn parse_triplet(
+    f: &[&str],
+    line: &str,
+    file: &str,
+    ln: usize,
+) -> Result<(usize, usize, f64), Error> {
+    if f.len() != 3 {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("expected 'row col value', got '{line}'"),
+        ));
+    }
+    let i: usize = f[0]
+        .parse()
+        .map_err(|_| Error::parse(file, ln, format!("bad row index '{}'", f[0])))?;
+    let j: usize = f[1]
+        .parse()
+        .map_err(|_| Error::parse(file, ln, format!("bad column index '{}'", f[1])))?;
+    let v =
+        parse_f64(f[2]).ok_or_else(|| Error::parse(file, ln, format!("bad value '{}'", f[2])))?;
+    Ok((i, j, v))
 }
 
 fn parse_f64(s: &str) -> Option<f64> {
@@ -303,21 +315,7 @@ pub fn parse_calculix_matrix(
             continue;
         }
         let f: Vec<&str> = t.split_whitespace().collect();
-        if f.len() != 3 {
-            return Err(Error::parse(
-                file,
-                ln + 1,
-                format!("expected 'row col value', got '{t}'"),
-            ));
-        }
-        let i: usize = f[0]
-            .parse()
-            .map_err(|_| Error::parse(file, ln + 1, format!("bad row '{}'", f[0])))?;
-        let j: usize = f[1]
-            .parse()
-            .map_err(|_| Error::parse(file, ln + 1, format!("bad column '{}'", f[1])))?;
-        let v = parse_f64(f[2])
-            .ok_or_else(|| Error::parse(file, ln + 1, format!("bad value '{}'", f[2])))?;
+        let (i, j, v) = parse_triplet(&f, t, file, ln + 1)?;
         if i == 0 || j == 0 || i > n || j > n {
             return Err(Error::parse(
                 file,
