@@ -39,6 +39,8 @@ pub struct Dynamics {
     pub(crate) load_factor: f64,
     /// A persistent scale of the loads (not gravity), e.g. for load sweeps.
     pub(crate) load_scale: f64,
+    /// The factorized static tangent of the last static Newton step (chord steps).
+    pub(crate) static_factor: Option<crate::statics::StaticFactor>,
     evaluations: u64,
 }
 
@@ -56,6 +58,7 @@ impl Dynamics {
             rhs: vec![0.0; n_q],
             load_factor: 1.0,
             load_scale: 1.0,
+            static_factor: None,
             evaluations: 0,
             mech,
         }

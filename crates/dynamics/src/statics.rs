@@ -42,6 +42,18 @@ impl Default for StaticOptions {
     }
 }
 
+/// A chord-Newton step is kept while it shrinks the update by at least this
+/// factor; otherwise the tangent is rebuilt at the current iterate.
+const CHORD_CONTRACTION: f64 = 0.2;
+
+/// The factorized static tangent kept between Newton iterations (and between
+/// calls, e.g. along a sweep) for chord steps.
+pub(crate) struct StaticFactor {
+    lu: DenseLu,
+    /// The free (not held) DOFs it was built for.
+    free: Vec<usize>,
+}
+
 /// An equilibrium.
 #[derive(Clone, Debug)]
 pub struct StaticSolution {
@@ -77,6 +89,25 @@ impl Dynamics {
         let l = self.load_stiffness(t);
         tangent -= &l;
         Ok((g, tangent))
+    }
+
+    /// The static out-of-balance g_s = E,qᵀσ − F,qᵀf of
+    /// [`static_tangent`](Self::static_tangent) without the tangent and
+    /// without F,q: with E,q = D,x F,q, g_s = F,qᵀ(D,xᵀσ − f), one adjoint
+    /// solve with the factorized kinematic Jacobian.
+    pub fn static_residual(&mut self, t: f64, q: &[f64]) -> Result<Vec<f64>, DynamicsError> {
+        self.kin
+            .solve(q, t)
+            .map_err(|e| DynamicsError::Kinematics { t, source: e })?;
+        self.forces(t, false);
+        for (w, f) in self.w.iter_mut().zip(&self.f) {
+            *w = -f;
+        }
+        self.kin.add_deformation_forces(&self.sigma, &mut self.w);
+        let mut g = vec![0.0; self.kin.n_q() + self.kin.n_u()];
+        self.kin.transfer_transpose_times(&self.w, &mut g);
+        g.truncate(self.kin.n_q());
+        Ok(g)
     }
 
     /// Kq = E,qᵀ S E,q (E.6d) plus controller gains.
@@ -200,6 +231,29 @@ impl Dynamics {
         l
     }
 
+    /// The tangent at q, factorized over the free DOFs and kept for chord
+    /// steps; returns the out-of-balance at q.
+    fn refresh_static_factor(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        free: &[usize],
+        load_factor: f64,
+    ) -> Result<Vec<f64>, DynamicsError> {
+        self.static_factor = None;
+        let (g, tan) = self.static_tangent(t, q)?;
+        let tf = Mat::from_fn(free.len(), free.len(), |a, b| tan[(free[a], free[b])]);
+        let mut lu = DenseLu::default();
+        if !lu.factor(tf.as_ref()) {
+            return Err(DynamicsError::SingularTangent { load_factor });
+        }
+        self.static_factor = Some(StaticFactor {
+            lu,
+            free: free.to_vec(),
+        });
+        Ok(g)
+    }
+
     /// Static equilibrium at time `t` (inputs at their values at t), starting
     /// from `q0`, with load increments and held degrees of freedom.
     pub fn static_equilibrium(
@@ -227,7 +281,7 @@ impl Dynamics {
         let mut increments = 0;
         let mut last_good = q.clone();
         let mut last_err = None;
-        let mut lu = DenseLu::default();
+        let mut force_refresh = false;
         while lambda < 1.0 - 1e-15 {
             let target = (lambda + dl).min(1.0);
             self.load_factor = if opts.ramp_loads { target } else { 1.0 };
@@ -235,36 +289,54 @@ impl Dynamics {
                 q[i] = held_start[k] + target * (v - held_start[k]);
             }
             let mut converged = false;
-            for _it in 0..opts.max_iterations {
+            let mut prev_dn = f64::INFINITY;
+            let mut steps = 0;
+            while steps < opts.max_iterations {
                 iterations += 1;
-                let (g, tan) = match self.static_tangent(t, &q) {
-                    Ok(v) => v,
+                // chord Newton: keep the factorized tangent (of an earlier
+                // iterate, increment or call) while its steps shrink by at
+                // least CHORD_CONTRACTION; a chord step that does not is
+                // rejected and replaced by a Newton step from the same point
+                let refreshed =
+                    force_refresh || self.static_factor.as_ref().is_none_or(|f| f.free != free);
+                let evaluated = if refreshed {
+                    self.refresh_static_factor(t, &q, &free, target)
+                } else {
+                    self.static_residual(t, &q)
+                };
+                let g = match evaluated {
+                    Ok(g) => g,
                     Err(e) => {
                         last_err = Some(e);
                         break;
                     }
                 };
-                let tf = Mat::from_fn(free.len(), free.len(), |a, b| tan[(free[a], free[b])]);
-                if !lu.factor(tf.as_ref()) {
-                    last_err = Some(DynamicsError::SingularTangent {
-                        load_factor: target,
-                    });
+                force_refresh = false;
+                let Some(factor) = &self.static_factor else {
                     break;
-                }
+                };
                 let mut dq: Vec<f64> = free.iter().map(|i| -g[*i]).collect();
-                lu.solve_vec(&mut dq, &mut Mat::zeros(free.len(), 1));
+                factor.lu.solve_vec(&mut dq, &mut Mat::zeros(free.len(), 1));
                 let qn = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 let dn = dq.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                for (k, i) in free.iter().enumerate() {
-                    q[*i] += dq[k];
+                // (NaN included: a non-finite chord step is rejected too)
+                let contracts = dn <= CHORD_CONTRACTION * prev_dn;
+                if !refreshed && !contracts {
+                    force_refresh = true;
+                    continue;
                 }
                 if !dn.is_finite() {
                     break;
+                }
+                steps += 1;
+                for (k, i) in free.iter().enumerate() {
+                    q[*i] += dq[k];
                 }
                 if dn <= opts.tol * (1.0 + qn) {
                     converged = true;
                     break;
                 }
+                prev_dn = dn;
             }
             if converged {
                 lambda = target;
@@ -272,6 +344,8 @@ impl Dynamics {
                 last_good.copy_from_slice(&q);
                 dl = (dl * 2.0).min(1.0);
             } else {
+                // retry a smaller increment with a tangent at its start
+                force_refresh = true;
                 q.copy_from_slice(&last_good);
                 self.kin.set_guess(&self.mech.x0.clone());
                 let _ = self.kin.solve(&q, t);
@@ -288,7 +362,7 @@ impl Dynamics {
             }
         }
         self.load_factor = 1.0;
-        let (g, _) = self.static_tangent(t, &q)?;
+        let g = self.static_residual(t, &q)?;
         let reactions = opts.held.iter().map(|(i, _)| g[*i]).collect();
         Ok(StaticSolution {
             q,

@@ -38,8 +38,10 @@
 #![warn(missing_docs)]
 
 mod lu;
+mod sparse_lu;
 
 pub use lu::DenseLu;
+pub use sparse_lu::SparseLu;
 
 use faer::Mat;
 use flexmb_model::{Coordinate, ERole, Mechanism, XRole};
@@ -139,8 +141,10 @@ pub struct Kinematics {
     eps: Vec<f64>,
     prev_eps: Vec<f64>,
     jac_local: Vec<Vec<f64>>,
-    jmat: Mat<f64>,
-    lu: DenseLu,
+    /// Sparse LU of J; `jpos[k][a·n_x,e + c]` is the position of element k's
+    /// local entry (a, c) in its values (`NO_ENTRY` when not in J).
+    lu: SparseLu,
+    jpos: Vec<Vec<usize>>,
     f: Mat<f64>,
     e: Mat<f64>,
     first_order_valid: bool,
@@ -161,9 +165,11 @@ pub struct Kinematics {
     xi_good: Vec<f64>,
     lu_valid: bool,
     dx: Vec<f64>,
-    col_buf: Mat<f64>,
     rhs_vec: Vec<f64>,
 }
+
+/// Marks a local Jacobian entry that is not part of J.
+const NO_ENTRY: usize = usize::MAX;
 
 impl Kinematics {
     /// Prepares the kinematics of a mechanism, starting from its reference configuration.
@@ -219,6 +225,7 @@ impl Kinematics {
             .map(|e| vec![0.0; e.element.n_eps() * e.element.n_x()])
             .collect();
         let n_xi = n_q + n_u;
+        let (lu, jpos) = jacobian_pattern(&maps, n_c);
         let mut s = Self {
             opts: NewtonOptions::default(),
             maps,
@@ -235,8 +242,8 @@ impl Kinematics {
             eps: vec![0.0; n_eps],
             prev_eps: vec![0.0; n_eps],
             jac_local,
-            jmat: Mat::zeros(n_c, n_c),
-            lu: DenseLu::default(),
+            lu,
+            jpos,
             f: Mat::zeros(n_x, n_xi),
             e: Mat::zeros(n_eps, n_xi),
             first_order_valid: false,
@@ -254,7 +261,6 @@ impl Kinematics {
             xi_good: vec![0.0; n_xi],
             lu_valid: false,
             dx: vec![0.0; n_c],
-            col_buf: Mat::zeros(n_c, 1),
             rhs_vec: vec![0.0; n_c],
             mech,
         };
@@ -393,16 +399,14 @@ impl Kinematics {
             .fold(0.0f64, f64::max)
     }
 
+    /// Scatters the element Jacobians into the values of J.
     fn assemble_jacobian(&mut self) {
-        self.jmat.fill(0.0);
-        for (k, m) in self.maps.iter().enumerate() {
-            let jl = &self.jac_local[k];
-            for (a, r) in m.rows.iter().enumerate() {
-                let Some(r) = r else { continue };
-                for (c, col) in m.cols.iter().enumerate() {
-                    if let Some(col) = col {
-                        self.jmat[(*r, *col)] += jl[a * m.nx + c];
-                    }
+        let values = self.lu.values_mut();
+        values.fill(0.0);
+        for (jl, pos) in self.jac_local.iter().zip(&self.jpos) {
+            for (v, &p) in jl.iter().zip(pos) {
+                if p != NO_ENTRY {
+                    values[p] += v;
                 }
             }
         }
@@ -411,7 +415,7 @@ impl Kinematics {
     fn singular_error(&self) -> KinematicsError {
         // null space of J by SVD names the undetermined coordinates
         let mut names = vec![];
-        if let Ok(svd) = self.jmat.svd() {
+        if let Ok(svd) = self.lu.to_dense().svd() {
             let s = svd.S().column_vector();
             let n = s.nrows();
             if n > 0 {
@@ -573,7 +577,7 @@ impl Kinematics {
             // without a usable one, or when chord steps converge slowly
             if converged || !lu_fresh_for_steps || (it > 0 && res > 0.1 * prev_res) {
                 self.assemble_jacobian();
-                if !self.lu.factor(self.jmat.as_ref()) {
+                if !self.lu.factor() {
                     self.lu_valid = false;
                     return Err(self.singular_error());
                 }
@@ -594,7 +598,7 @@ impl Kinematics {
             }
             prev_res = res;
             self.dx[..n_c].copy_from_slice(&self.work[..n_c]);
-            self.lu.solve_vec(&mut self.dx[..n_c], &mut self.col_buf);
+            self.lu.solve_vec(&mut self.dx[..n_c]);
             let dx = std::mem::take(&mut self.dx);
             // step with backtracking: halve while the residual grows
             let mut step = 1.0;
@@ -736,6 +740,64 @@ impl Kinematics {
         self.first_order_valid = true;
     }
 
+    /// F,ξᵀ y for a vector y over the nodal coordinates, at the last solved
+    /// configuration, by one adjoint solve with Jᵀ and without forming F,ξ:
+    /// with F,ξ = J⁻¹B on the dependent coordinates (thesis (5.8a)),
+    /// F,ξᵀy = y_ξ + Bᵀ(J⁻ᵀ y_dep), B the right-hand side of
+    /// [`first_order`](Self::first_order). `out` has n_q + n_u entries.
+    pub fn transfer_transpose_times(&mut self, y: &[f64], out: &mut [f64]) {
+        let mech = self.mech.clone();
+        let mut mu = std::mem::take(&mut self.rhs_vec);
+        for (k, &i) in mech.dependent.iter().enumerate() {
+            mu[k] = y[i];
+        }
+        self.lu.solve_transpose_vec(&mut mu);
+        out.fill(0.0);
+        // nodal coordinates in ξ: their own entry minus Σ μ_r ∂D_r/∂x_i
+        for (i, k) in self.xi_of_x.iter().enumerate() {
+            if let Some(k) = k {
+                out[*k] += y[i];
+            }
+        }
+        for (ei, e) in mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            let jl = &self.jac_local[ei];
+            for (c, gi) in e.x_index.iter().enumerate() {
+                let Some(k) = self.xi_of_x[*gi] else { continue };
+                for (a, r) in m.rows.iter().enumerate() {
+                    if let Some(r) = r {
+                        out[k] -= jl[a * m.nx + c] * mu[*r];
+                    }
+                }
+            }
+        }
+        // deformation coordinates in ξ: a unit entry on their row
+        for (j, k) in self.xi_of_e.iter().enumerate() {
+            if let (Some(k), Some(r)) = (k, self.row_of[j]) {
+                out[*k] += mu[r];
+            }
+        }
+        self.rhs_vec = mu;
+    }
+
+    /// y += D,xᵀ s, the nodal forces of deformation stresses s (all
+    /// deformations, at the last solved configuration).
+    pub fn add_deformation_forces(&self, s: &[f64], y: &mut [f64]) {
+        for (ei, e) in self.mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            let jl = &self.jac_local[ei];
+            for a in 0..m.ne {
+                let v = s[e.eps_offset + a];
+                if v == 0.0 {
+                    continue;
+                }
+                for (c, gi) in e.x_index.iter().enumerate() {
+                    y[*gi] += jl[a * m.nx + c] * v;
+                }
+            }
+        }
+    }
+
     /// ẋ = F,ξ ξ̇ and ε̇ = E,ξ ξ̇ with ξ̇ = (q̇, u̇(t)). Call after [`first_order`](Self::first_order).
     pub fn velocities(&mut self, qd: &[f64]) {
         let (n_q, n_u) = (self.n_q, self.n_u);
@@ -824,7 +886,7 @@ impl Kinematics {
                 }
             }
         }
-        self.lu.solve_vec(&mut rhs, &mut self.col_buf);
+        self.lu.solve_vec(&mut rhs);
         self.xdd0.fill(0.0);
         for (k, &i) in mech.dependent.iter().enumerate() {
             self.xdd0[i] = rhs[k];
@@ -1055,8 +1117,7 @@ impl Kinematics {
                 }
             }
         }
-        let mut buf = Mat::zeros(y.len(), 1);
-        self.lu.solve_transpose_vec(&mut y, &mut buf);
+        self.lu.solve_transpose_vec(&mut y);
         let mu = y;
         // HF = Σ_e scatter(H_e F_e), then G = F,qᵀ HF with one product
         let n_x = mech.n_x();
@@ -1128,6 +1189,30 @@ impl Kinematics {
         }
         g
     }
+}
+
+/// The pattern of J (constraint rows × dependent coordinates) from the
+/// elements' row and column maps, and each element's scatter positions.
+fn jacobian_pattern(maps: &[ElemMap], n_c: usize) -> (SparseLu, Vec<Vec<usize>>) {
+    let mut entries = vec![];
+    let mut owner = vec![];
+    for (k, m) in maps.iter().enumerate() {
+        for (a, r) in m.rows.iter().enumerate() {
+            let Some(r) = r else { continue };
+            for (c, col) in m.cols.iter().enumerate() {
+                if let Some(col) = col {
+                    entries.push((*r, *col));
+                    owner.push((k, a * m.nx + c));
+                }
+            }
+        }
+    }
+    let (lu, positions) = SparseLu::new(n_c, &entries);
+    let mut jpos: Vec<Vec<usize>> = maps.iter().map(|m| vec![NO_ENTRY; m.ne * m.nx]).collect();
+    for ((k, local), p) in owner.into_iter().zip(positions) {
+        jpos[k][local] = p;
+    }
+    (lu, jpos)
 }
 
 /// Mean distance between the first two position slots of the elements that

@@ -119,7 +119,7 @@ fn geometric_contraction_matches_differences() {
     // G = ∂/∂q (F,qᵀ w + E,qᵀ σ) with w, σ frozen.
     let mut rng = StdRng::seed_from_u64(4);
     for dofs in [DofChoice::Deformations, DofChoice::NodalCoordinates] {
-        let mut k = kinematics("straight_guidance_spatial.ron", dofs);
+        let mut k = kinematics("straight_guidance_spatial.ron", dofs.clone());
         let q = deflected(&k, &mut rng, 2e-3);
         let (nx, ne, nq) = (k.x().len(), k.eps().len(), k.n_q());
         let w: Vec<f64> = (0..nx).map(|_| rng.random_range(-1.0..1.0)).collect();
@@ -201,4 +201,48 @@ fn unreachable_configuration_reports_the_equations_that_fail() {
         "{msg}"
     );
     assert!(k.solve(&[f64::NAN], 0.0).is_err());
+}
+
+/// The adjoint product F,ξᵀy (one solve with Jᵀ) equals the product with the
+/// explicit F,ξ, and D,xᵀs with E,ξᵀs = F,ξᵀD,xᵀs, for deformation and nodal
+/// DOFs of the spatial guidance (a closed loop) at a deflected configuration.
+#[test]
+fn adjoint_transfer_matches_the_explicit_product() {
+    for dofs in [DofChoice::Deformations, DofChoice::NodalCoordinates] {
+        let mut rng = StdRng::seed_from_u64(11);
+        let mut k = kinematics("straight_guidance_spatial.ron", dofs.clone());
+        let q = deflected(&k, &mut rng, 2e-3);
+        k.solve(&q, 0.0).unwrap();
+        let mech = k.mechanism().clone();
+        let y: Vec<f64> = (0..mech.n_x())
+            .map(|_| rng.random_range(-1.0..1.0))
+            .collect();
+        let s: Vec<f64> = (0..mech.n_eps())
+            .map(|_| rng.random_range(-1.0..1.0))
+            .collect();
+        let n_xi = k.n_q() + k.n_u();
+        let mut adj = vec![0.0; n_xi];
+        k.transfer_transpose_times(&y, &mut adj);
+        let mut ys = vec![0.0; mech.n_x()];
+        k.add_deformation_forces(&s, &mut ys);
+        let mut adj_s = vec![0.0; n_xi];
+        k.transfer_transpose_times(&ys, &mut adj_s);
+        k.first_order();
+        let (f, e) = (k.f_xi(), k.e_xi());
+        for c in 0..n_xi {
+            let fy: f64 = (0..mech.n_x()).map(|i| f[(i, c)] * y[i]).sum();
+            let es: f64 = (0..mech.n_eps()).map(|j| e[(j, c)] * s[j]).sum();
+            let scale = 1.0 + fy.abs();
+            assert!(
+                (adj[c] - fy).abs() < 1e-10 * scale,
+                "{dofs:?} F,ξᵀy[{c}]: {} vs {fy}",
+                adj[c]
+            );
+            assert!(
+                (adj_s[c] - es).abs() < 1e-10 * (1.0 + es.abs()),
+                "{dofs:?} E,ξᵀs[{c}]: {} vs {es}",
+                adj_s[c]
+            );
+        }
+    }
 }
