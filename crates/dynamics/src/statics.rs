@@ -110,61 +110,85 @@ impl Dynamics {
         Ok(g)
     }
 
-    /// Kq = E,qᵀ S E,q (E.6d) plus controller gains.
+    /// Kq = E,qᵀ S E,q (E.6d) plus controller gains, summed element by
+    /// element over the columns where the element's rows of E,q are not all
+    /// zero (with deformation DOFs of a serial chain that is the element's
+    /// own DOFs: Kq is then assembled in O(n) instead of an n_ε × n_q² product).
     pub(crate) fn structural_stiffness(&self) -> Mat<f64> {
         let mech = &self.mech;
         let n_q = mech.n_dof();
         let e = self.kin.e_xi();
         let f = self.kin.f_xi();
-        // SE = blockdiag(S_e) E (rigid and prescribed rows are zero), K = Eᵀ SE
-        let n_e = mech.n_eps();
-        let mut se = Mat::<f64>::zeros(n_e, n_q);
-        let mut ef = Mat::<f64>::zeros(n_e, n_q);
-        let mut gains = vec![0.0; n_e];
+        let mut gains = vec![0.0; mech.n_eps()];
         for c in &mech.controllers {
             if let Coordinate::Def(j) = c.on {
                 gains[j] += c.kp;
             }
         }
+        let mut k = Mat::<f64>::zeros(n_q, n_q);
+        let mut cols: Vec<usize> = Vec::with_capacity(n_q);
+        let mut ee: Vec<f64> = vec![];
+        let mut se: Vec<f64> = vec![];
         for el in &mech.elements {
             let ne = el.element.n_eps();
-            if ne == 0 {
-                continue;
-            }
-            let s = el.element.stiffness();
             let o = el.eps_offset;
-            let active = |a: usize| {
-                !matches!(
+            let mut active = [0usize; 64];
+            let mut na = 0;
+            for a in 0..ne {
+                if !matches!(
                     mech.e_roles[o + a],
                     flexmb_model::ERole::Rigid | flexmb_model::ERole::Input(_)
-                )
-            };
+                ) {
+                    active[na] = a;
+                    na += 1;
+                }
+            }
+            if na == 0 {
+                continue;
+            }
+            let active = &active[..na];
+            cols.clear();
             for col in 0..n_q {
-                let ecol = e.col_as_slice(col);
-                for a in 0..ne {
-                    if !active(a) {
+                let ecol = &e.col_as_slice(col)[o..o + ne];
+                if active.iter().any(|&a| ecol[a] != 0.0) {
+                    cols.push(col);
+                }
+            }
+            let nz = cols.len();
+            // ee = E_e (na × nz) and se = (S_e + gains) E_e, row-major
+            ee.clear();
+            ee.resize(na * nz, 0.0);
+            se.clear();
+            se.resize(na * nz, 0.0);
+            for (c, &col) in cols.iter().enumerate() {
+                let ecol = &e.col_as_slice(col)[o..o + ne];
+                for (i, &a) in active.iter().enumerate() {
+                    ee[i * nz + c] = ecol[a];
+                }
+            }
+            let s = el.element.stiffness();
+            for (i, &a) in active.iter().enumerate() {
+                for (l, &b) in active.iter().enumerate() {
+                    let w = s[(a, b)] + if a == b { gains[o + a] } else { 0.0 };
+                    if w == 0.0 {
                         continue;
                     }
-                    ef[(o + a, col)] = ecol[o + a];
-                    let mut v = gains[o + a] * ecol[o + a];
-                    for b in 0..ne {
-                        if active(b) {
-                            v += s[(a, b)] * ecol[o + b];
-                        }
+                    for c in 0..nz {
+                        se[i * nz + c] += w * ee[l * nz + c];
                     }
-                    se[(o + a, col)] = v;
+                }
+            }
+            for (c2, &col2) in cols.iter().enumerate() {
+                let kcol = k.col_as_slice_mut(col2);
+                for (c1, &col1) in cols.iter().enumerate() {
+                    let mut v = 0.0;
+                    for i in 0..na {
+                        v += ee[i * nz + c1] * se[i * nz + c2];
+                    }
+                    kcol[col1] += v;
                 }
             }
         }
-        let mut k = Mat::<f64>::zeros(n_q, n_q);
-        faer::linalg::matmul::matmul(
-            k.as_mut(),
-            faer::Accum::Replace,
-            ef.transpose(),
-            se.as_ref(),
-            1.0,
-            faer::Par::Seq,
-        );
         for c in &mech.controllers {
             if let Coordinate::Node(i) = c.on {
                 let row: Vec<f64> = (0..n_q).map(|k| f[(i, k)]).collect();

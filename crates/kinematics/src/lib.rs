@@ -37,11 +37,11 @@
 //! ```
 #![warn(missing_docs)]
 
+mod jacobian_lu;
 mod lu;
-mod sparse_lu;
 
+pub use jacobian_lu::{JacobianLu, DENSE_UP_TO};
 pub use lu::DenseLu;
-pub use sparse_lu::SparseLu;
 
 use faer::Mat;
 use flexmb_model::{Coordinate, ERole, Mechanism, XRole};
@@ -141,9 +141,9 @@ pub struct Kinematics {
     eps: Vec<f64>,
     prev_eps: Vec<f64>,
     jac_local: Vec<Vec<f64>>,
-    /// Sparse LU of J; `jpos[k][a·n_x,e + c]` is the position of element k's
+    /// LU of J (sparse, or dense when small); `jpos[k][a·n_x,e + c]` is the position of element k's
     /// local entry (a, c) in its values (`NO_ENTRY` when not in J).
-    lu: SparseLu,
+    lu: JacobianLu,
     jpos: Vec<Vec<usize>>,
     f: Mat<f64>,
     e: Mat<f64>,
@@ -174,6 +174,12 @@ const NO_ENTRY: usize = usize::MAX;
 impl Kinematics {
     /// Prepares the kinematics of a mechanism, starting from its reference configuration.
     pub fn new(mech: Arc<Mechanism>) -> Self {
+        Self::with_dense_limit(mech, DENSE_UP_TO)
+    }
+
+    /// As [`new`](Self::new), with the kinematic Jacobian factorized densely
+    /// only when it has at most `dense_up_to` rows (sparse otherwise).
+    pub fn with_dense_limit(mech: Arc<Mechanism>, dense_up_to: usize) -> Self {
         faer::set_global_parallelism(faer::Par::Seq);
         let n_x = mech.n_x();
         let n_eps = mech.n_eps();
@@ -225,7 +231,7 @@ impl Kinematics {
             .map(|e| vec![0.0; e.element.n_eps() * e.element.n_x()])
             .collect();
         let n_xi = n_q + n_u;
-        let (lu, jpos) = jacobian_pattern(&maps, n_c);
+        let (lu, jpos) = jacobian_pattern(&maps, n_c, dense_up_to);
         let mut s = Self {
             opts: NewtonOptions::default(),
             maps,
@@ -1193,7 +1199,11 @@ impl Kinematics {
 
 /// The pattern of J (constraint rows × dependent coordinates) from the
 /// elements' row and column maps, and each element's scatter positions.
-fn jacobian_pattern(maps: &[ElemMap], n_c: usize) -> (SparseLu, Vec<Vec<usize>>) {
+fn jacobian_pattern(
+    maps: &[ElemMap],
+    n_c: usize,
+    dense_up_to: usize,
+) -> (JacobianLu, Vec<Vec<usize>>) {
     let mut entries = vec![];
     let mut owner = vec![];
     for (k, m) in maps.iter().enumerate() {
@@ -1207,7 +1217,7 @@ fn jacobian_pattern(maps: &[ElemMap], n_c: usize) -> (SparseLu, Vec<Vec<usize>>)
             }
         }
     }
-    let (lu, positions) = SparseLu::new(n_c, &entries);
+    let (lu, positions) = JacobianLu::with_dense_limit(n_c, &entries, dense_up_to);
     let mut jpos: Vec<Vec<usize>> = maps.iter().map(|m| vec![NO_ENTRY; m.ne * m.nx]).collect();
     for ((k, local), p) in owner.into_iter().zip(positions) {
         jpos[k][local] = p;

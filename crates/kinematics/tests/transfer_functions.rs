@@ -21,6 +21,14 @@ fn kinematics(name: &str, dofs: DofChoice) -> Kinematics {
     Kinematics::new(Arc::new(s.build(None).unwrap()))
 }
 
+/// The same with the sparse factorization of the Jacobian (small mechanisms
+/// get the dense one by default).
+fn sparse_kinematics(name: &str, dofs: DofChoice) -> Kinematics {
+    let mut s = scene(name);
+    s.dofs = dofs;
+    Kinematics::with_dense_limit(Arc::new(s.build(None).unwrap()), 0)
+}
+
 /// A deflected configuration: q0 plus a random perturbation of a few percent
 /// of the flexure length in deformation terms.
 fn deflected(k: &Kinematics, rng: &mut StdRng, scale: f64) -> Vec<f64> {
@@ -36,8 +44,20 @@ fn x_at(k: &mut Kinematics, q: &[f64]) -> Vec<f64> {
 }
 
 fn check_first_and_second_order(name: &str, dofs: DofChoice, scale: f64) {
+    check_derivatives(
+        kinematics(name, dofs.clone()),
+        &format!("{name} dense"),
+        scale,
+    );
+    check_derivatives(
+        sparse_kinematics(name, dofs),
+        &format!("{name} sparse"),
+        scale,
+    );
+}
+
+fn check_derivatives(mut k: Kinematics, name: &str, scale: f64) {
     let mut rng = StdRng::seed_from_u64(3);
-    let mut k = kinematics(name, dofs);
     // second differences amplify the solve tolerance by 1/h²: solve to rounding level
     k.set_newton_options(NewtonOptions {
         tol: 1e-17,
@@ -208,9 +228,19 @@ fn unreachable_configuration_reports_the_equations_that_fail() {
 /// DOFs of the spatial guidance (a closed loop) at a deflected configuration.
 #[test]
 fn adjoint_transfer_matches_the_explicit_product() {
-    for dofs in [DofChoice::Deformations, DofChoice::NodalCoordinates] {
+    for (dofs, sparse) in [
+        (DofChoice::Deformations, false),
+        (DofChoice::NodalCoordinates, false),
+        (DofChoice::Deformations, true),
+        (DofChoice::NodalCoordinates, true),
+    ] {
         let mut rng = StdRng::seed_from_u64(11);
-        let mut k = kinematics("straight_guidance_spatial.ron", dofs.clone());
+        let name = "straight_guidance_spatial.ron";
+        let mut k = if sparse {
+            sparse_kinematics(name, dofs.clone())
+        } else {
+            kinematics(name, dofs.clone())
+        };
         let q = deflected(&k, &mut rng, 2e-3);
         k.solve(&q, 0.0).unwrap();
         let mech = k.mechanism().clone();

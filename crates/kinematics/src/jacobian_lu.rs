@@ -1,5 +1,6 @@
-//! A sparse LU factorization of the kinematic Jacobian J = ∂D_c/∂x_dep
-//! (constraint rows × dependent coordinates, thesis (5.8a), (6.6a)).
+//! The LU factorization of the kinematic Jacobian J = ∂D_c/∂x_dep
+//! (constraint rows × dependent coordinates, thesis (5.8a), (6.6a)): sparse
+//! for large mechanisms, dense for small ones.
 //!
 //! J has a fixed pattern: row `r` of element e couples only e's own
 //! coordinates. The pattern, a fill-reducing column ordering (COLAMD) and the
@@ -8,6 +9,10 @@
 //! left-looking LU with partial pivoting. For the 840 × 840 Jacobian of a
 //! 120-beam chain this replaces an O(n³) dense factorization and O(n²) dense
 //! solves per right-hand side by work proportional to the factor's non-zeros.
+//! Below `DENSE_UP_TO` rows the dense factorization is faster (measured: the
+//! 77 × 77 Jacobian of the 44-DOF spatial guidance factors in about 12 µs
+//! dense and 40 µs sparse, its 44 right-hand sides solve 2–3× faster dense),
+//! so small Jacobians are copied into a dense matrix and factorized densely.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::PermRef;
@@ -19,10 +24,20 @@ use faer::sparse::linalg::lu::simplicial::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, MatMut, Par};
 
-use crate::lu::SINGULAR_PIVOT_RATIO;
+use crate::lu::{DenseLu, SINGULAR_PIVOT_RATIO};
+
+/// Jacobians with at most this many rows are factorized densely.
+pub const DENSE_UP_TO: usize = 200;
+
+/// The dense factorization of a small Jacobian.
+struct DenseFactor {
+    matrix: Mat<f64>,
+    lu: DenseLu,
+    buf: Mat<f64>,
+}
 
 /// The factorized Jacobian, with its pattern and all work memory.
-pub struct SparseLu {
+pub struct JacobianLu {
     n: usize,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
@@ -36,14 +51,15 @@ pub struct SparseLu {
     mem: MemBuffer,
     /// Right-hand sides the work memory is sized for.
     rhs_capacity: usize,
+    dense: Option<DenseFactor>,
     factored: bool,
     /// Smallest |Uᵢᵢ| / largest |Uᵢᵢ| of the last factorization (0 when it failed).
     pub pivot_ratio: f64,
 }
 
-impl std::fmt::Debug for SparseLu {
+impl std::fmt::Debug for JacobianLu {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("SparseLu")
+        f.debug_struct("JacobianLu")
             .field("n", &self.n)
             .field("nnz", &self.row_idx.len())
             .field("pivot_ratio", &self.pivot_ratio)
@@ -51,11 +67,20 @@ impl std::fmt::Debug for SparseLu {
     }
 }
 
-impl SparseLu {
+impl JacobianLu {
     /// Sets up the pattern of an n × n matrix from its (row, column) entries
     /// (duplicates allowed) and returns, for each entry in the given order,
     /// its position in [`values_mut`](Self::values_mut).
     pub fn new(n: usize, entries: &[(usize, usize)]) -> (Self, Vec<usize>) {
+        Self::with_dense_limit(n, entries, DENSE_UP_TO)
+    }
+
+    /// As [`new`](Self::new), factorizing densely when n ≤ `dense_up_to`.
+    pub fn with_dense_limit(
+        n: usize,
+        entries: &[(usize, usize)],
+        dense_up_to: usize,
+    ) -> (Self, Vec<usize>) {
         let mut sorted: Vec<(usize, usize)> = entries.iter().map(|&(r, c)| (c, r)).collect();
         sorted.sort_unstable();
         sorted.dedup();
@@ -111,6 +136,11 @@ impl SparseLu {
             lu: SimplicialLu::new(),
             mem: MemBuffer::new(Self::scratch(n, rhs_capacity)),
             rhs_capacity,
+            dense: (n <= dense_up_to).then(|| DenseFactor {
+                matrix: Mat::zeros(n, n),
+                lu: DenseLu::default(),
+                buf: Mat::zeros(n, 1),
+            }),
             factored: false,
             pivot_ratio: 0.0,
         };
@@ -160,6 +190,17 @@ impl SparseLu {
         if self.values.iter().any(|v| !v.is_finite()) {
             return false;
         }
+        if let Some(d) = &mut self.dense {
+            d.matrix.fill(0.0);
+            for c in 0..n {
+                for p in self.col_ptr[c]..self.col_ptr[c + 1] {
+                    d.matrix[(self.row_idx[p], c)] += self.values[p];
+                }
+            }
+            self.factored = d.lu.factor(d.matrix.as_ref());
+            self.pivot_ratio = d.lu.pivot_ratio;
+            return self.factored;
+        }
         let a = SparseColMatRef::new(
             SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx),
             &self.values,
@@ -207,6 +248,10 @@ impl SparseLu {
         if !self.factored || self.n == 0 || b.ncols() == 0 {
             return;
         }
+        if let Some(d) = &self.dense {
+            d.lu.solve_in_place(b);
+            return;
+        }
         self.ensure_rhs(b.ncols());
         let n = self.n;
         self.lu.solve_in_place_with_conj(
@@ -224,6 +269,10 @@ impl SparseLu {
         if !self.factored || self.n == 0 || b.ncols() == 0 {
             return;
         }
+        if let Some(d) = &self.dense {
+            d.lu.solve_transpose_in_place(b);
+            return;
+        }
         self.ensure_rhs(b.ncols());
         let n = self.n;
         self.lu.solve_transpose_in_place_with_conj(
@@ -238,12 +287,20 @@ impl SparseLu {
 
     /// Solves J x = b for one vector in place.
     pub fn solve_vec(&mut self, b: &mut [f64]) {
+        if let (Some(d), true) = (&mut self.dense, self.factored) {
+            d.lu.solve_vec(b, &mut d.buf);
+            return;
+        }
         let n = b.len();
         self.solve_in_place(faer::MatMut::from_column_major_slice_mut(b, n, 1));
     }
 
     /// Solves Jᵀ x = b for one vector in place.
     pub fn solve_transpose_vec(&mut self, b: &mut [f64]) {
+        if let (Some(d), true) = (&mut self.dense, self.factored) {
+            d.lu.solve_transpose_vec(b, &mut d.buf);
+            return;
+        }
         let n = b.len();
         self.solve_transpose_in_place(faer::MatMut::from_column_major_slice_mut(b, n, 1));
     }
@@ -253,9 +310,16 @@ impl SparseLu {
 mod tests {
     use super::*;
 
-    /// A random sparse, diagonally weighted matrix against faer's dense LU.
+    /// A random sparse, diagonally weighted matrix against a dense product,
+    /// with the sparse and the dense factorization.
     #[test]
     fn solves_agree_with_dense() {
+        for limit in [0, usize::MAX] {
+            random_system(limit);
+        }
+    }
+
+    fn random_system(dense_up_to: usize) {
         let n = 30;
         let mut entries = vec![];
         let mut vals = vec![];
@@ -276,7 +340,7 @@ mod tests {
                 vals.push(rnd());
             }
         }
-        let (mut lu, pos) = SparseLu::new(n, &entries);
+        let (mut lu, pos) = JacobianLu::with_dense_limit(n, &entries, dense_up_to);
         lu.values_mut().fill(0.0);
         for (p, v) in pos.iter().zip(&vals) {
             lu.values_mut()[*p] += v;
@@ -296,22 +360,28 @@ mod tests {
 
     #[test]
     fn singular_matrix_is_reported() {
+        for limit in [0, usize::MAX] {
+            singular_cases(limit);
+        }
+    }
+
+    fn singular_cases(limit: usize) {
         // two equal rows
         let entries = [(0, 0), (0, 1), (1, 0), (1, 1), (2, 2)];
-        let (mut lu, pos) = SparseLu::new(3, &entries);
+        let (mut lu, pos) = JacobianLu::with_dense_limit(3, &entries, limit);
         for (p, v) in pos.iter().zip([1.0, 2.0, 1.0, 2.0, 1.0]) {
             lu.values_mut()[*p] = v;
         }
         assert!(!lu.factor());
         assert!(lu.pivot_ratio < SINGULAR_PIVOT_RATIO);
         // structurally singular: an empty column
-        let (mut lu, pos) = SparseLu::new(2, &[(0, 0), (1, 0)]);
+        let (mut lu, pos) = JacobianLu::with_dense_limit(2, &[(0, 0), (1, 0)], limit);
         for p in pos {
             lu.values_mut()[p] = 1.0;
         }
         assert!(!lu.factor());
         // non-finite
-        let (mut lu, pos) = SparseLu::new(1, &[(0, 0)]);
+        let (mut lu, pos) = JacobianLu::with_dense_limit(1, &[(0, 0)], limit);
         lu.values_mut()[pos[0]] = f64::NAN;
         assert!(!lu.factor());
     }
