@@ -56,6 +56,9 @@ struct Assembly {
     mfe: Mat<f64>,
     /// A compact |S| × |S| block for column sets that are not contiguous.
     c: Mat<f64>,
+    /// Per element, its x_index as runs of consecutive global indices
+    /// (global start, local start, length): a node's coordinates are adjacent.
+    runs: Vec<Vec<(usize, usize, usize)>>,
 }
 
 /// Rows of stacked W_e before a product WᵀW is added to Mq.
@@ -80,32 +83,45 @@ impl Assembly {
             re: vec![0.0; nmax * nmax],
             mfe: Mat::zeros(nmax, n_q),
             c: Mat::zeros(n_q, n_q),
+            runs: mech
+                .elements
+                .iter()
+                .map(|e| {
+                    let mut r: Vec<(usize, usize, usize)> = vec![];
+                    for (k, &g) in e.x_index.iter().enumerate() {
+                        match r.last_mut() {
+                            Some((g0, _, len)) if *g0 + *len == g => *len += 1,
+                            _ => r.push((g, k, 1)),
+                        }
+                    }
+                    r
+                })
+                .collect(),
         }
     }
 
-    /// Adds F_eᵀ M_e F_e of one element (local coordinates `xl`) to the lower
-    /// triangle of Mq (possibly at the next [`flush`](Self::flush)).
+    /// Adds F_eᵀ M_e F_e of element `ei` (local coordinates `xl`) to the
+    /// lower triangle of Mq (possibly at the next [`flush`](Self::flush)).
     fn add_element(
         &mut self,
+        ei: usize,
         el: &Element,
-        x_index: &[usize],
         xl: &[f64],
         fq: &Mat<f64>,
         n_q: usize,
         mq: &mut Mat<f64>,
     ) {
-        let n = x_index.len();
+        let n = xl.len();
         // the non-zero columns of F_e, gathered
+        let runs = &self.runs[ei];
         let mut s = 0;
         for c in 0..n_q {
             let col = fq.col_as_slice(c);
             let dst = &mut self.fe.col_as_slice_mut(s)[..n];
-            let mut any = false;
-            for (d, &i) in dst.iter_mut().zip(x_index) {
-                *d = col[i];
-                any |= *d != 0.0;
+            for &(g, k, len) in runs {
+                dst[k..k + len].copy_from_slice(&col[g..g + len]);
             }
-            if any {
+            if dst.iter().any(|v| *v != 0.0) {
                 self.cur[s] = c;
                 s += 1;
             }
@@ -402,7 +418,7 @@ impl Dynamics {
         let mut vl = [0.0; 64];
         let mut al = [0.0; 64];
         let mut fl = [0.0; 64];
-        for e in &mech.elements {
+        for (ei, e) in mech.elements.iter().enumerate() {
             if !e.element.has_inertia() {
                 continue;
             }
@@ -418,7 +434,7 @@ impl Dynamics {
                 self.w[*gi] -= fl[k];
             }
             if mass {
-                asm.add_element(&e.element, &e.x_index, &xl[..n], fq, n_q, &mut self.mq);
+                asm.add_element(ei, &e.element, &xl[..n], fq, n_q, &mut self.mq);
             }
         }
         if mass {
