@@ -3,8 +3,13 @@
 //! element by element, and the residual g(q, q̇, q̈, t) of (E.1).
 
 use crate::DynamicsError;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
+use faer::linalg::matmul::matmul;
+use faer::linalg::matmul::triangular::{matmul as tri_matmul, BlockStructure};
 use faer::linalg::solvers::Solve;
-use faer::Mat;
+use faer::{Accum, Mat, MatMut, MatRef, Par};
+use flexmb_element::Element;
 use flexmb_kinematics::Kinematics;
 use flexmb_model::{Coordinate, ERole, Load, Mechanism};
 use flexmb_rotation::EulerParameters;
@@ -25,6 +30,192 @@ pub struct Energies {
     pub gravity_exact: bool,
 }
 
+/// Work arrays of the element-block assembly Mq = Σ_e F_eᵀ M_e F_e (D.10).
+///
+/// For each element, the columns of F,q that are not zero on its rows form
+/// the set S (ascending), and F_e is gathered on them (n × |S|). With the
+/// factor M_e = R_eᵀR_e the element adds W_eᵀW_e, W_e = R_e F_e. The W_e of
+/// consecutive elements with the same S are stacked (up to [`STACK_ROWS`]
+/// rows) and added to Mq by one product WᵀW when S changes; on a contiguous S
+/// directly into the diagonal block of Mq, else through a compact block.
+struct Assembly {
+    /// Column set of the stacked W (first `pending` entries valid).
+    cols: Vec<usize>,
+    pending: usize,
+    /// Rows of W in use.
+    rows: usize,
+    /// Column set of the current element.
+    cur: Vec<usize>,
+    /// F_e (n × |S|).
+    fe: Mat<f64>,
+    /// The stacked W (`STACK_ROWS` + n_max rows).
+    w: Mat<f64>,
+    /// The factor R_e (or the mass matrix M_e), row-major.
+    re: Vec<f64>,
+    /// M_e F_e for elements without a factor.
+    mfe: Mat<f64>,
+    /// A compact |S| × |S| block for column sets that are not contiguous.
+    c: Mat<f64>,
+    /// Per element, its x_index as runs of consecutive global indices
+    /// (global start, local start, length): a node's coordinates are adjacent.
+    runs: Vec<Vec<(usize, usize, usize)>>,
+}
+
+/// Rows of stacked W_e before a product WᵀW is added to Mq.
+const STACK_ROWS: usize = 96;
+
+impl Assembly {
+    fn new(mech: &flexmb_model::Mechanism) -> Self {
+        let n_q = mech.n_dof();
+        let nmax = mech
+            .elements
+            .iter()
+            .map(|e| e.x_index.len())
+            .max()
+            .unwrap_or(0);
+        Self {
+            cols: vec![0; n_q],
+            pending: 0,
+            rows: 0,
+            cur: vec![0; n_q],
+            fe: Mat::zeros(nmax, n_q),
+            w: Mat::zeros(STACK_ROWS + nmax, n_q),
+            re: vec![0.0; nmax * nmax],
+            mfe: Mat::zeros(nmax, n_q),
+            c: Mat::zeros(n_q, n_q),
+            runs: mech
+                .elements
+                .iter()
+                .map(|e| {
+                    let mut r: Vec<(usize, usize, usize)> = vec![];
+                    for (k, &g) in e.x_index.iter().enumerate() {
+                        match r.last_mut() {
+                            Some((g0, _, len)) if *g0 + *len == g => *len += 1,
+                            _ => r.push((g, k, 1)),
+                        }
+                    }
+                    r
+                })
+                .collect(),
+        }
+    }
+
+    /// Adds F_eᵀ M_e F_e of element `ei` (local coordinates `xl`) to the
+    /// lower triangle of Mq (possibly at the next [`flush`](Self::flush)).
+    fn add_element(
+        &mut self,
+        ei: usize,
+        el: &Element,
+        xl: &[f64],
+        fq: &Mat<f64>,
+        n_q: usize,
+        mq: &mut Mat<f64>,
+    ) {
+        let n = xl.len();
+        // the non-zero columns of F_e, gathered
+        let runs = &self.runs[ei];
+        let mut s = 0;
+        for c in 0..n_q {
+            let col = fq.col_as_slice(c);
+            let dst = &mut self.fe.col_as_slice_mut(s)[..n];
+            for &(g, k, len) in runs {
+                dst[k..k + len].copy_from_slice(&col[g..g + len]);
+            }
+            if dst.iter().any(|v| *v != 0.0) {
+                self.cur[s] = c;
+                s += 1;
+            }
+        }
+        if s == 0 {
+            return;
+        }
+        let Some(m) = el.mass_factor(xl, &mut self.re) else {
+            // no factor: F_eᵀ (M_e F_e) at once
+            el.mass_matrix(xl, &mut self.re[..n * n]);
+            let me = MatRef::from_row_major_slice(&self.re[..n * n], n, n);
+            let fe = self.fe.as_ref().submatrix(0, 0, n, s);
+            let mut mfe = self.mfe.as_mut().submatrix_mut(0, 0, n, s);
+            matmul(mfe.as_mut(), Accum::Replace, me, fe, 1.0, Par::Seq);
+            let mut c = self.c.as_mut().submatrix_mut(0, 0, s, s);
+            matmul(
+                c.as_mut(),
+                Accum::Replace,
+                fe.transpose(),
+                mfe.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            add_lower(mq, c.as_ref(), &self.cur[..s]);
+            return;
+        };
+        if m == 0 {
+            return;
+        }
+        if self.cur[..s] != self.cols[..self.pending] || self.rows + m > STACK_ROWS {
+            self.flush(mq);
+            self.cols[..s].copy_from_slice(&self.cur[..s]);
+            self.pending = s;
+        }
+        let r = MatRef::from_row_major_slice(&self.re[..m * n], m, n);
+        let fe = self.fe.as_ref().submatrix(0, 0, n, s);
+        let w = self.w.as_mut().submatrix_mut(self.rows, 0, m, s);
+        matmul(w, Accum::Replace, r, fe, 1.0, Par::Seq);
+        self.rows += m;
+    }
+
+    /// Adds WᵀW of the stacked rows to Mq and empties the stack.
+    fn flush(&mut self, mq: &mut Mat<f64>) {
+        let (s, rows) = (self.pending, self.rows);
+        self.pending = 0;
+        self.rows = 0;
+        if s == 0 || rows == 0 {
+            return;
+        }
+        let w = self.w.as_ref().submatrix(0, 0, rows, s);
+        let c0 = self.cols[0];
+        if self.cols[s - 1] - c0 + 1 == s {
+            // contiguous columns: straight into the diagonal block
+            let dst = mq.as_mut().submatrix_mut(c0, c0, s, s);
+            tri_matmul(
+                dst,
+                BlockStructure::TriangularLower,
+                Accum::Add,
+                w.transpose(),
+                BlockStructure::Rectangular,
+                w,
+                BlockStructure::Rectangular,
+                1.0,
+                Par::Seq,
+            );
+        } else {
+            let mut c = self.c.as_mut().submatrix_mut(0, 0, s, s);
+            tri_matmul(
+                c.as_mut(),
+                BlockStructure::TriangularLower,
+                Accum::Replace,
+                w.transpose(),
+                BlockStructure::Rectangular,
+                w,
+                BlockStructure::Rectangular,
+                1.0,
+                Par::Seq,
+            );
+            add_lower(mq, c.as_ref(), &self.cols[..s]);
+        }
+    }
+}
+
+/// Adds the lower triangle of the compact block `c` on the (ascending) index
+/// set `idx` to the lower triangle of `mq`.
+fn add_lower(mq: &mut Mat<f64>, c: MatRef<'_, f64>, idx: &[usize]) {
+    for (a, &ia) in idx.iter().enumerate() {
+        let col = mq.col_as_slice_mut(ia);
+        for (b, &ib) in idx.iter().enumerate().skip(a) {
+            col[ib] += c[(b, a)];
+        }
+    }
+}
+
 /// The dynamics of one mechanism: kinematics plus forces; holds all buffers.
 pub struct Dynamics {
     pub(crate) kin: Kinematics,
@@ -32,9 +223,13 @@ pub struct Dynamics {
     pub(crate) f: Vec<f64>,
     pub(crate) sigma: Vec<f64>,
     pub(crate) w: Vec<f64>,
-    pub(crate) mf: Mat<f64>,
     pub(crate) mq: Mat<f64>,
     pub(crate) rhs: Vec<f64>,
+    /// Work arrays of the element-block assembly of Mq.
+    asm: Assembly,
+    /// The Cholesky factor of Mq (lower triangle) and its workspace.
+    llt: Mat<f64>,
+    llt_mem: MemBuffer,
     /// Factor on loads and gravity (load stepping in statics).
     pub(crate) load_factor: f64,
     /// A persistent scale of the loads (not gravity), e.g. for load sweeps.
@@ -53,9 +248,15 @@ impl Dynamics {
             f: vec![0.0; n_x],
             sigma: vec![0.0; n_e],
             w: vec![0.0; n_x],
-            mf: Mat::zeros(n_x, n_q),
             mq: Mat::zeros(n_q, n_q),
             rhs: vec![0.0; n_q],
+            asm: Assembly::new(&mech),
+            llt: Mat::zeros(n_q, n_q),
+            llt_mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(
+                n_q,
+                Par::Seq,
+                Default::default(),
+            )),
             load_factor: 1.0,
             load_scale: 1.0,
             static_factor: None,
@@ -197,7 +398,12 @@ impl Dynamics {
         }
     }
 
-    /// Assembles w = f − Mx ẍ0 − h and, if `mass`, Mf = Mx F,q and Mq = F,qᵀ Mx F,q.
+    /// Assembles w = f − Mx ẍ0 − h and, if `mass`, Mq = F,qᵀ Mx F,q (D.10)
+    /// element by element: Mq = Σ_e F_eᵀ M_e F_e with F_e the rows of F,q at
+    /// the element's coordinates, restricted to the columns where F_e is not
+    /// zero. With the factor M_e = R_eᵀR_e of co-rotational inertia
+    /// (R_e = Ū B̂, (3.31)) the block is W_eᵀW_e, W_e = R_e F_e; only the lower
+    /// triangle is accumulated, then mirrored.
     pub(crate) fn inertia(&mut self, mass: bool) {
         let mech = self.mech.clone();
         let n_q = mech.n_dof();
@@ -206,15 +412,16 @@ impl Dynamics {
         let xdd0 = self.kin.xdd0();
         let fq = self.kin.f_xi();
         self.w.copy_from_slice(&self.f);
+        let asm = &mut self.asm;
         if mass {
-            self.mf.fill(0.0);
+            self.mq.fill(0.0);
+            asm.pending = 0;
         }
         let mut xl = [0.0; 64];
         let mut vl = [0.0; 64];
         let mut al = [0.0; 64];
         let mut fl = [0.0; 64];
-        let mut ml = [0.0; 64 * 64];
-        for e in &mech.elements {
+        for (ei, e) in mech.elements.iter().enumerate() {
             if !e.element.has_inertia() {
                 continue;
             }
@@ -230,66 +437,41 @@ impl Dynamics {
                 self.w[*gi] -= fl[k];
             }
             if mass {
-                e.element.mass_matrix(&xl[..n], &mut ml[..n * n]);
-                // Mf[x_index, :] += M_e F_e, column by column (contiguous)
-                for c in 0..n_q {
-                    let fcol = fq.col_as_slice(c);
-                    let mut any = false;
-                    for (b, gb) in e.x_index.iter().enumerate() {
-                        fl[b] = fcol[*gb];
-                        any |= fl[b] != 0.0;
-                    }
-                    if !any {
-                        continue;
-                    }
-                    let mcol = self.mf.col_as_slice_mut(c);
-                    for (a, ga) in e.x_index.iter().enumerate() {
-                        let row = &ml[a * n..a * n + n];
-                        let mut s = 0.0;
-                        for b in 0..n {
-                            s += row[b] * fl[b];
-                        }
-                        mcol[*ga] += s;
-                    }
-                }
+                asm.add_element(ei, &e.element, &xl[..n], fq, n_q, &mut self.mq);
             }
         }
         if mass {
-            let f = fq.subcols(0, n_q);
-            faer::linalg::matmul::matmul(
-                self.mq.as_mut(),
-                faer::Accum::Replace,
-                f.transpose(),
-                self.mf.as_ref(),
-                1.0,
-                faer::Par::Seq,
-            );
+            asm.flush(&mut self.mq);
+            // mirror the lower triangle
+            for c in 0..n_q {
+                for r in c + 1..n_q {
+                    self.mq[(c, r)] = self.mq[(r, c)];
+                }
+            }
         }
     }
 
     /// rhs = F,qᵀ w − E,qᵀ σ.
     pub(crate) fn generalized_force(&mut self) {
         let n_q = self.mech.n_dof();
-        let fq = self.kin.f_xi();
-        let eq = self.kin.e_xi();
-        for c in 0..n_q {
-            let a: f64 = fq
-                .col_as_slice(c)
-                .iter()
-                .zip(&self.w)
-                .map(|(f, w)| f * w)
-                .sum();
-            let b: f64 = eq
-                .col_as_slice(c)
-                .iter()
-                .zip(&self.sigma)
-                .map(|(e, s)| e * s)
-                .sum();
-            self.rhs[c] = a - b;
-        }
+        let fq = self.kin.f_xi().subcols(0, n_q);
+        let eq = self.kin.e_xi().subcols(0, n_q);
+        let mut rhs = MatMut::from_column_major_slice_mut(&mut self.rhs, n_q, 1);
+        let w = MatRef::from_column_major_slice(&self.w, self.w.len(), 1);
+        let sigma = MatRef::from_column_major_slice(&self.sigma, self.sigma.len(), 1);
+        matmul(
+            rhs.as_mut(),
+            Accum::Replace,
+            fq.transpose(),
+            w,
+            1.0,
+            Par::Seq,
+        );
+        matmul(rhs, Accum::Add, eq.transpose(), sigma, -1.0, Par::Seq);
     }
 
-    /// The equations of motion (D.10) solved for q̈ at (t, q, q̇).
+    /// The equations of motion (D.10) solved for q̈ at (t, q, q̇): Cholesky of
+    /// Mq in a preallocated buffer, then two triangular solves.
     pub fn accelerations(
         &mut self,
         t: f64,
@@ -302,23 +484,65 @@ impl Dynamics {
         self.forces(t, true);
         self.inertia(true);
         self.generalized_force();
-        let llt = self
-            .mq
-            .llt(faer::Side::Lower)
-            .map_err(|_| self.singular_mass())?;
-        let mut r = Mat::from_fn(self.rhs.len(), 1, |i, _| self.rhs[i]);
-        llt.solve_in_place(r.as_mut());
-        for (i, v) in qdd.iter_mut().enumerate() {
-            *v = r[(i, 0)];
-            if !v.is_finite() {
-                return Err(DynamicsError::NonFinite {
-                    what: "q̈",
-                    index: i,
-                    t,
-                });
-            }
+        let n = self.rhs.len();
+        for c in 0..n {
+            let (src, dst) = (self.mq.col_as_slice(c), self.llt.col_as_slice_mut(c));
+            dst[c..].copy_from_slice(&src[c..]);
+        }
+        let stack = MemStack::new(&mut self.llt_mem);
+        if cholesky_in_place(
+            self.llt.as_mut(),
+            Default::default(),
+            Par::Seq,
+            stack,
+            Default::default(),
+        )
+        .is_err()
+        {
+            return Err(self.singular_mass());
+        }
+        let qdd = &mut qdd[..n];
+        qdd.copy_from_slice(&self.rhs);
+        faer::linalg::cholesky::llt::solve::solve_in_place(
+            self.llt.as_ref(),
+            MatMut::from_column_major_slice_mut(qdd, n, 1),
+            Par::Seq,
+            MemStack::new(&mut self.llt_mem),
+        );
+        if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
+            return Err(DynamicsError::NonFinite {
+                what: "q̈",
+                index: i,
+                t,
+            });
         }
         Ok(())
+    }
+
+    /// Mx v (element by element), added to `out` (length n_x).
+    pub(crate) fn mass_times_add(&self, v: &[f64], out: &mut [f64]) {
+        let x = self.kin.x();
+        let mut xl = [0.0; 64];
+        let mut ml = [0.0; 64 * 64];
+        for e in &self.mech.elements {
+            if !e.element.has_inertia() {
+                continue;
+            }
+            let n = e.x_index.len();
+            for (k, gi) in e.x_index.iter().enumerate() {
+                xl[k] = x[*gi];
+            }
+            e.element.mass_matrix(&xl[..n], &mut ml[..n * n]);
+            for (a, ga) in e.x_index.iter().enumerate() {
+                let row = &ml[a * n..a * n + n];
+                out[*ga] += e
+                    .x_index
+                    .iter()
+                    .zip(row)
+                    .map(|(gb, m)| m * v[*gb])
+                    .sum::<f64>();
+            }
+        }
     }
 
     fn singular_mass(&self) -> DynamicsError {
@@ -483,5 +707,158 @@ impl Dynamics {
         // inputs do work too (prescribed motion): their reaction is not known
         // here; report only the applied forces
         Ok(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flexmb_model::Scene;
+    use std::path::Path;
+
+    fn fixture(name: &str) -> Scene {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fixtures/scenes")
+            .join(name);
+        Scene::load(&p).unwrap()
+    }
+
+    /// A spatial mechanism with every kind of spatial inertia: beams (one with
+    /// B1, one with B2), a truss with mass, a point mass and a rigid body with
+    /// an offset centre of mass.
+    fn mixed_spatial() -> Scene {
+        Scene::from_ron_str(
+            r#"(
+            dimension: Spatial,
+            gravity: Some([0.0, 0.0, -9.81]),
+            materials: { "m": (e: 2.1e11, nu: 0.3, rho: 7800.0) },
+            sections: { "s": Rectangle(by: 0.02, bz: 0.004) },
+            nodes: [
+                (id: "A", at: [0.0, 0.0, 0.0]),
+                (id: "B", at: [0.3, 0.0, 0.0]),
+                (id: "C", at: [0.3, 0.2, 0.1]),
+                (id: "D", at: [0.0, 0.2, 0.0]),
+            ],
+            elements: [
+                (id: "b1", type: Beam((nodes: ("A", "B"), material: "m", section: "s", up: Some([0.0, 0.0, 1.0]), n: 2, transform: B1))),
+                (id: "b2", type: Beam((nodes: ("B", "C"), material: "m", section: "s", up: Some([0.0, 0.0, 1.0]), transform: B2))),
+                (id: "b3", type: Beam((nodes: ("C", "D"), material: "m", section: "s", up: Some([0.0, 0.0, 1.0])))),
+                (id: "t", type: Truss(nodes: ("A", "C"), ea: 1.0e6, mass_per_length: 0.5)),
+                (id: "pm", type: PointMass(node: "B", mass: 0.7)),
+                (id: "rb", type: RigidBody(node: "D", mass: 1.3, com: Some([0.01, -0.02, 0.03]),
+                    inertia: [[0.01, 0.001, 0.0], [0.001, 0.02, 0.0], [0.0, 0.0, 0.015]])),
+            ],
+            fixed: [Node("A")],
+            rigid: [Def("b1", "elongation"), Def("b2", "elongation")],
+        )"#,
+        )
+        .unwrap()
+    }
+
+    /// Mq and the generalized force against the plain formulas: a dense Mx from
+    /// the element mass matrices, F,qᵀ Mx F,q, and F,qᵀ w − E,qᵀ σ.
+    fn check_against_dense(scene: Scene) {
+        let mech = Arc::new(scene.build(None).unwrap());
+        let mut dy = Dynamics::new(mech.clone());
+        let n = dy.n_q();
+        let q: Vec<f64> = mech
+            .q0()
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + 1e-3 * ((i % 7) as f64 - 3.0))
+            .collect();
+        let qd: Vec<f64> = (0..n).map(|i| 0.1 * ((i % 5) as f64 - 2.0)).collect();
+        let (mq, rhs) = dy.mass_and_force(0.01, &q, &qd).unwrap();
+        let (mq, rhs) = (mq.clone(), rhs.to_vec());
+        let n_x = mech.n_x();
+        let x = dy.kin.x().to_vec();
+        let mut mx = Mat::<f64>::zeros(n_x, n_x);
+        for e in &mech.elements {
+            let k = e.x_index.len();
+            let xl: Vec<f64> = e.x_index.iter().map(|i| x[*i]).collect();
+            let mut ml = vec![0.0; k * k];
+            e.element.mass_matrix(&xl, &mut ml);
+            for (a, ga) in e.x_index.iter().enumerate() {
+                for (b, gb) in e.x_index.iter().enumerate() {
+                    mx[(*ga, *gb)] += ml[a * k + b];
+                }
+            }
+        }
+        let f = dy.kin.f_xi().subcols(0, n).to_owned();
+        let reference = f.transpose() * &mx * &f;
+        let scale = (0..n).fold(0.0f64, |m, i| m.max(reference[(i, i)].abs()));
+        assert!(scale > 0.0);
+        for r in 0..n {
+            for c in 0..n {
+                assert!(
+                    (mq[(r, c)] - reference[(r, c)]).abs() <= 1e-12 * scale,
+                    "Mq({r}, {c}) = {} vs {}",
+                    mq[(r, c)],
+                    reference[(r, c)]
+                );
+            }
+        }
+        let e = dy.kin.e_xi();
+        for c in 0..n {
+            let mut s = 0.0;
+            let mut mag = 0.0f64;
+            for i in 0..n_x {
+                s += f[(i, c)] * dy.w[i];
+                mag = mag.max((f[(i, c)] * dy.w[i]).abs());
+            }
+            for j in 0..dy.sigma.len() {
+                s -= e[(j, c)] * dy.sigma[j];
+                mag = mag.max((e[(j, c)] * dy.sigma[j]).abs());
+            }
+            assert!((rhs[c] - s).abs() <= 1e-12 * mag.max(1e-300), "rhs {c}");
+        }
+        // q̈ solves Mq q̈ = rhs
+        let mut qdd = vec![0.0; n];
+        dy.accelerations(0.01, &q, &qd, &mut qdd).unwrap();
+        for r in 0..n {
+            let s: f64 = (0..n).map(|c| reference[(r, c)] * qdd[c]).sum();
+            let mag: f64 = (0..n)
+                .map(|c| (reference[(r, c)] * qdd[c]).abs())
+                .fold(rhs[r].abs(), f64::max);
+            assert!(
+                (s - rhs[r]).abs() <= 1e-9 * mag,
+                "row {r}: {s} vs {}",
+                rhs[r]
+            );
+        }
+    }
+
+    #[test]
+    fn element_block_mass_matches_the_dense_product() {
+        check_against_dense(fixture("straight_guidance_spatial.ron"));
+        check_against_dense(fixture("straight_guidance_planar.ron"));
+        check_against_dense(fixture("manipulator_planar.ron"));
+        check_against_dense(mixed_spatial());
+    }
+
+    #[test]
+    fn massless_degrees_of_freedom_are_named() {
+        let scene = Scene::from_ron_str(
+            r#"(
+            dimension: Planar,
+            materials: { "m": (e: 1.0e9, rho: 0.0) },
+            sections: { "s": Circle(d: 0.01) },
+            nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [1.0, 0.0]) ],
+            elements: [
+                (id: "rod", type: Beam((nodes: ("A", "B"), material: "m", section: "s", mass: false))),
+                (id: "bob", type: PointMass(node: "B", mass: 2.0)),
+            ],
+            fixed: [ Coord("A", Position) ],
+        )"#,
+        )
+        .unwrap();
+        let mut dy = Dynamics::new(Arc::new(scene.build(None).unwrap()));
+        let n = dy.n_q();
+        let mut qdd = vec![0.0; n];
+        let q = dy.mechanism().q0();
+        match dy.accelerations(0.0, &q, &vec![0.0; n], &mut qdd) {
+            Err(DynamicsError::SingularMass { dofs }) => assert!(!dofs.is_empty(), "{dofs:?}"),
+            other => panic!("expected SingularMass, got {other:?}"),
+        }
     }
 }

@@ -233,14 +233,15 @@ impl Dynamics {
         let n_q = self.n_q();
         let mq = self.mq.clone();
         // w' = Mx ẍ − f = −w + Mx F,q q̈
-        let mut wq = vec![0.0; self.w.len()];
-        for i in 0..wq.len() {
-            let mut s = -self.w[i];
-            for c in 0..n_q {
-                s += self.mf[(i, c)] * qdd[c];
+        let mut xdd_q = vec![0.0; self.w.len()];
+        let f = self.kin.f_xi();
+        for (c, v) in qdd.iter().enumerate().take(n_q) {
+            for (o, fv) in xdd_q.iter_mut().zip(f.col_as_slice(c)) {
+                *o += fv * v;
             }
-            wq[i] = s;
         }
+        let mut wq: Vec<f64> = self.w.iter().map(|v| -v).collect();
+        self.mass_times_add(&xdd_q, &mut wq);
         let sigma = self.sigma.clone();
         let mut k = self.kin.second_order_contraction(&wq, &sigma);
         k += &self.structural_stiffness();

@@ -7,7 +7,7 @@ use crate::beam_matrices::{
     equivalent_stiffness, planar_a_diag, planar_beam_m_bar, planar_beam_s_bar, spatial_a_diag,
     spatial_beam_m_bar, spatial_beam_s_bar,
 };
-use crate::inertia::{PlanarInertia, SpatialInertia, VelocityTransform, MAX_MODES};
+use crate::inertia::{psd_factor, PlanarInertia, SpatialInertia, VelocityTransform, MAX_MODES};
 use crate::kernels::{
     jacobian, second_directional, third_directional, weighted_hessian, DefKernel,
     NormalizationKernel, PlanarBeamKernel, PlanarHingeKernel, SpatialHingeKernel, TrussKernel,
@@ -234,11 +234,13 @@ impl Element {
         let beta0 = (q[1] - p[1]).atan2(q[0] - p[0]);
         let s_bar = DMatrix::from_iterator(3, 3, planar_beam_s_bar(mat, &sec, l0).iter().copied());
         let s = equivalent_stiffness(&s_bar, &planar_a_diag(l0));
-        let inertia = (opts.inertia && mat.rho > 0.0).then(|| PlanarInertia {
-            nodes: 2,
-            variant: opts.velocity_transform,
-            beta0,
-            mbar: DMatrix::from_iterator(6, 6, planar_beam_m_bar(mat, &sec, l0).iter().copied()),
+        let inertia = (opts.inertia && mat.rho > 0.0).then(|| {
+            PlanarInertia::new(
+                2,
+                opts.velocity_transform,
+                beta0,
+                DMatrix::from_iterator(6, 6, planar_beam_m_bar(mat, &sec, l0).iter().copied()),
+            )
         });
         Ok(Self::new(
             Kind::PlanarBeam(
@@ -349,12 +351,7 @@ impl Element {
         variant: VelocityTransform,
     ) -> Self {
         let s = equivalent_stiffness(s_bar, &spatial_a_diag(l0));
-        let inertia = m_bar.map(|mbar| SpatialInertia {
-            nodes: 2,
-            variant,
-            r0t: transpose3(&r0),
-            mbar,
-        });
+        let inertia = m_bar.map(|mbar| SpatialInertia::new(2, variant, transpose3(&r0), mbar));
         let mut n = names(&SPATIAL_NAMES);
         n.extend((0..modes).map(|i| format!("mode_{}", i + 1)));
         Self::new(
@@ -481,12 +478,12 @@ impl Element {
             }
         }
         Ok(Self::new(
-            Kind::RigidBody(SpatialInertia {
-                nodes: 1,
-                variant: VelocityTransform::B1,
-                r0t: transpose3(&r0),
+            Kind::RigidBody(SpatialInertia::new(
+                1,
+                VelocityTransform::B1,
+                transpose3(&r0),
                 mbar,
-            }),
+            )),
             vec![Slot::Position3, Slot::Orientation],
             vec![],
             DMatrix::zeros(0, 0),
@@ -908,6 +905,35 @@ impl Element {
                 }
             }
             _ => {}
+        }
+    }
+
+    /// A factor R of the mass matrix, M = RᵀR (row-major m × n_x with
+    /// m ≤ n_x), written to `out`; returns m (0 for massless elements). For
+    /// co-rotational inertia R = Ū B̂ with the constant M̄ = ŪᵀŪ, so that
+    /// Fᵀ M F = (R F)ᵀ(R F) needs no n_x × n_x product (thesis (3.31), (D.10)).
+    /// `None` if M has no such factor (an indefinite M̄); use
+    /// [`mass_matrix`](Self::mass_matrix) then.
+    pub fn mass_factor(&self, x: &[f64], out: &mut [f64]) -> Option<usize> {
+        let n = self.n_x();
+        match &self.kind {
+            Kind::PlanarBeam(_, Some(i)) => i.mass_factor(x, out),
+            Kind::TwoNode {
+                inertia: Some(i), ..
+            }
+            | Kind::RigidBody(i) => i.mass_factor(x, out),
+            Kind::PlanarTruss { .. }
+            | Kind::Truss { .. }
+            | Kind::PlanarMass { .. }
+            | Kind::PointMass { .. } => {
+                // constant and at most 6 × 6
+                let mut m = [0.0; 36];
+                self.mass_matrix(x, &mut m);
+                let u = psd_factor(&m[..n * n], n)?;
+                out[..n * n].copy_from_slice(&u);
+                Some(n)
+            }
+            _ => Some(0),
         }
     }
 

@@ -15,7 +15,7 @@
 //! respect to x, ẋ and ẍ follow.
 
 use flexmb_dual::{Dual, Mat3, Real, Vec3};
-use flexmb_rotation::generic::{average, lambda_bar_mat, lambda_mat, rotation};
+use flexmb_rotation::generic::{average, hemisphere_sign, lambda_bar_mat, lambda_mat, rotation};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -54,7 +54,52 @@ pub(crate) struct SpatialInertia {
     /// R0ᵀ (rows are the local axes in the global frame).
     pub r0t: [[f64; 3]; 3],
     pub mbar: DMatrix<f64>,
+    /// Ū with M̄ = ŪᵀŪ (row-major, upper triangular); `None` if M̄ is indefinite.
+    pub ubar: Option<Vec<f64>>,
 }
+
+/// An upper-triangular U with A = UᵀU (row-major n × n) of a symmetric positive
+/// semi-definite A (row-major): Cholesky, where a pivot below 1e-13 of the
+/// largest diagonal entry gives a zero row (a massless direction). `None` if A
+/// is indefinite.
+pub(crate) fn psd_factor(a: &[f64], n: usize) -> Option<Vec<f64>> {
+    let scale = (0..n).fold(0.0f64, |m, i| m.max(a[i * n + i].abs()));
+    let tol = 1e-13 * scale;
+    let mut u = vec![0.0; n * n];
+    for k in 0..n {
+        let d = a[k * n + k] - (0..k).map(|i| u[i * n + k] * u[i * n + k]).sum::<f64>();
+        if !d.is_finite() || d < -tol {
+            return None;
+        }
+        if d <= tol {
+            // a massless direction: the rest of the row must vanish too
+            for j in k + 1..n {
+                let r = a[k * n + j] - (0..k).map(|i| u[i * n + k] * u[i * n + j]).sum::<f64>();
+                if r.abs() > 1e-6 * scale {
+                    return None;
+                }
+            }
+            continue;
+        }
+        let ukk = d.sqrt();
+        u[k * n + k] = ukk;
+        for j in k + 1..n {
+            let r = a[k * n + j] - (0..k).map(|i| u[i * n + k] * u[i * n + j]).sum::<f64>();
+            u[k * n + j] = r / ukk;
+        }
+    }
+    Some(u)
+}
+
+/// Ū of a mass matrix M̄ (see [`psd_factor`]).
+fn mbar_factor(mbar: &DMatrix<f64>) -> Option<Vec<f64>> {
+    let n = mbar.nrows();
+    let a: Vec<f64> = (0..n * n).map(|k| mbar[(k / n, k % n)]).collect();
+    psd_factor(&a, n)
+}
+
+/// The non-zeros of the columns of B̂ (thesis (3.31)): (row, value) × up to 3.
+type BhatColumns = ([[(usize, f64); 3]; 14 + MAX_MODES], [usize; 14 + MAX_MODES]);
 
 fn mat34_scaled<T: Real>(a: &Mat3<T>, l: &[[T; 4]; 3], s: f64) -> [[T; 4]; 3] {
     std::array::from_fn(|i| {
@@ -74,6 +119,21 @@ fn m34_tr_vec<T: Real>(m: &[[T; 4]; 3], w: &[T]) -> [T; 4] {
 }
 
 impl SpatialInertia {
+    pub fn new(
+        nodes: usize,
+        variant: VelocityTransform,
+        r0t: [[f64; 3]; 3],
+        mbar: DMatrix<f64>,
+    ) -> Self {
+        let ubar = mbar_factor(&mbar);
+        Self {
+            nodes,
+            variant,
+            r0t,
+            mbar,
+            ubar,
+        }
+    }
     pub fn nx_nodes(&self) -> usize {
         7 * self.nodes
     }
@@ -188,6 +248,19 @@ impl SpatialInertia {
         self.apply_t_add(&bdot, &p, 1.0, out);
         self.apply_t_add(&b, &q, 1.0, out);
         // − B*ᵀ p = − ∂(pᵀ B(x) ẋ)/∂x: B depends on the Euler parameters only.
+        if !self.bstar_t_p_sub(x, xd, &p, out) {
+            self.bstar_t_p_sub_dual(x, xd, &p, out);
+        }
+        for i in nv..nw {
+            out[nxn + i - nv] = q[i];
+        }
+    }
+
+    /// out −= B*ᵀ p = ∂(pᵀ B(x) ẋ)/∂x (Appendix C) by one dual pass over the
+    /// eight Euler parameters; any velocity transform.
+    fn bstar_t_p_sub_dual<T: Real>(&self, x: &[T], xd: &[T], p: &[T], out: &mut [T]) {
+        let nxn = self.nx_nodes();
+        let nv = self.nv();
         let xl: [Dual<T, 8>; 14] = std::array::from_fn(|i| {
             let n = i / 7;
             let k = i % 7;
@@ -218,9 +291,90 @@ impl SpatialInertia {
                 out[7 * n + 3 + k] -= phi.eps[4 * n + k];
             }
         }
-        for i in nv..nw {
-            out[nxn + i - nv] = q[i];
+    }
+
+    /// out −= B*ᵀ p in closed form where B's orientation blocks are linear in
+    /// each node's own λ: the rigid body (ft = R0ᵀR(λ)ᵀ, g = 2R0ᵀΛ̄(λ)) and B3
+    /// (ft = R0ᵀR(λr)ᵀ with the average λr (2.29), g_n = 2R0ᵀΛ̄(λn), (3.29)).
+    /// With a_n = R0 p_v,n and C = Σ_n ṙ_n a_nᵀ, pᵀ ft ṙ = Σ_jk R_jk C_jk, whose
+    /// gradient with respect to the frame quaternion is 2K(C)λ; and
+    /// uᵀΛ̄(λ)λ̇ = −uᵀΛ̄(λ̇)λ gives ∂/∂λ = −Λ̄(λ̇)ᵀu. Returns false (nothing done)
+    /// for B1 and B2.
+    fn bstar_t_p_sub<T: Real>(&self, x: &[T], xd: &[T], p: &[T], out: &mut [T]) -> bool {
+        if self.nodes == 2 && self.variant != VelocityTransform::B3 {
+            return false;
         }
+        let r0t = &self.r0t;
+        // C = Σ_n ṙ_n (R0 p_v,n)ᵀ
+        let mut c = [[T::zero(); 3]; 3];
+        for n in 0..self.nodes {
+            let pv = &p[6 * n..6 * n + 3];
+            let a: [T; 3] =
+                std::array::from_fn(|k| pv[0] * r0t[0][k] + pv[1] * r0t[1][k] + pv[2] * r0t[2][k]);
+            let rd = &xd[7 * n..7 * n + 3];
+            for j in 0..3 {
+                for k in 0..3 {
+                    c[j][k] += rd[j] * a[k];
+                }
+            }
+        }
+        let lp: [T; 4] = [x[3], x[4], x[5], x[6]];
+        let (lf, sign, inv) = if self.nodes == 1 {
+            (lp, 1.0, T::one())
+        } else {
+            let lq: [T; 4] = [x[10], x[11], x[12], x[13]];
+            let s = hemisphere_sign(&lp, &lq);
+            let sum: [T; 4] = std::array::from_fn(|i| lp[i] + lq[i] * s);
+            let nrm =
+                (sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2] + sum[3] * sum[3]).sqrt();
+            let inv = T::one() / nrm;
+            (sum.map(|v| v * inv), s, inv)
+        };
+        // ∂(Σ R_jk C_jk)/∂λ = 2 K λ, K symmetric
+        let [l0, l1, l2, l3] = lf;
+        let k00 = c[0][0] + c[1][1] + c[2][2];
+        let k11 = c[0][0] - c[1][1] - c[2][2];
+        let k22 = c[1][1] - c[0][0] - c[2][2];
+        let k33 = c[2][2] - c[0][0] - c[1][1];
+        let k01 = c[2][1] - c[1][2];
+        let k02 = c[0][2] - c[2][0];
+        let k03 = c[1][0] - c[0][1];
+        let k12 = c[0][1] + c[1][0];
+        let k13 = c[0][2] + c[2][0];
+        let k23 = c[1][2] + c[2][1];
+        let mut g = [
+            (l0 * k00 + l1 * k01 + l2 * k02 + l3 * k03) * 2.0,
+            (l0 * k01 + l1 * k11 + l2 * k12 + l3 * k13) * 2.0,
+            (l0 * k02 + l1 * k12 + l2 * k22 + l3 * k23) * 2.0,
+            (l0 * k03 + l1 * k13 + l2 * k23 + l3 * k33) * 2.0,
+        ];
+        if self.nodes == 2 {
+            // through λr = σ/|σ|, σ = λp + s λq: (I − λr λrᵀ)/|σ|
+            let d = g[0] * l0 + g[1] * l1 + g[2] * l2 + g[3] * l3;
+            for (gi, li) in g.iter_mut().zip(lf) {
+                *gi = (*gi - li * d) * inv;
+            }
+            for k in 0..4 {
+                out[3 + k] -= g[k];
+                out[10 + k] -= g[k] * sign;
+            }
+        } else {
+            for k in 0..4 {
+                out[3 + k] -= g[k];
+            }
+        }
+        // rotations: 2 (R0 p_ω,n)ᵀ Λ̄(λn) λ̇n, gradient −2 Λ̄(λ̇n)ᵀ R0 p_ω,n
+        for n in 0..self.nodes {
+            let pw = &p[6 * n + 3..6 * n + 6];
+            let u: [T; 3] =
+                std::array::from_fn(|k| pw[0] * r0t[0][k] + pw[1] * r0t[1][k] + pw[2] * r0t[2][k]);
+            let ld: [T; 4] = [xd[7 * n + 3], xd[7 * n + 4], xd[7 * n + 5], xd[7 * n + 6]];
+            let lb = lambda_bar_mat(&ld);
+            for k in 0..4 {
+                out[7 * n + 3 + k] += (lb[0][k] * u[0] + lb[1][k] * u[1] + lb[2][k] * u[2]) * 2.0;
+            }
+        }
+        true
     }
 
     /// The generalized force of a uniform acceleration field `g` (gravity):
@@ -254,16 +408,14 @@ impl SpatialInertia {
         }
     }
 
-    /// The mass matrix M = \[B; I\]ᵀ M̄ \[B; I\] (row-major, n × n with
-    /// n = 7·nodes + modes). Each column of B̂ = \[B 0; 0 I\] has at most three
-    /// non-zeros, so M_ij = Σ B̂_ki M̄_kl B̂_lj costs at most nine products.
-    pub fn mass(&self, x: &[f64], out: &mut [f64]) {
+    /// The columns of B̂ = \[B 0; 0 I\] (3.31) at x: each has at most three
+    /// non-zeros (a column of the 3×3 frame block, of a 3×4 Λ block, or a unit
+    /// entry for a mode amplitude).
+    fn bhat_columns(&self, x: &[f64]) -> BhatColumns {
         let nxn = self.nx_nodes();
         let nv = self.nv();
         let nw = self.mbar.nrows();
-        let n = nxn + nw - nv;
         let b = self.blocks(x);
-        // sparse columns of B̂: (row, value) × up to 3
         let mut cols = [[(0usize, 0.0f64); 3]; 14 + MAX_MODES];
         let mut cnt = [0usize; 14 + MAX_MODES];
         for nd in 0..self.nodes {
@@ -284,18 +436,69 @@ impl SpatialInertia {
             cols[nxn + i - nv][0] = (i, 1.0);
             cnt[nxn + i - nv] = 1;
         }
+        (cols, cnt)
+    }
+
+    /// The mass matrix M = \[B; I\]ᵀ M̄ \[B; I\] (3.31) (row-major, n × n with
+    /// n = 7·nodes + modes). Each column of B̂ = \[B 0; 0 I\] has at most three
+    /// non-zeros: first P = M̄ B̂ (nw × n, three products per entry), then the
+    /// upper triangle of M = B̂ᵀ P (three products per entry), mirrored.
+    pub fn mass(&self, x: &[f64], out: &mut [f64]) {
+        let nxn = self.nx_nodes();
+        let nv = self.nv();
+        let nw = self.mbar.nrows();
+        let n = nxn + nw - nv;
+        let (cols, cnt) = self.bhat_columns(x);
+        let mbar = self.mbar.as_slice(); // column-major: M̄[:, k] is contiguous
+                                         // P row-major nw × n
+        let mut p = [0.0f64; MAX_W * (14 + MAX_MODES)];
+        for j in 0..n {
+            for &(k, bk) in &cols[j][..cnt[j]] {
+                let mk = &mbar[k * nw..(k + 1) * nw];
+                for (a, m) in mk.iter().enumerate() {
+                    p[a * n + j] += m * bk;
+                }
+            }
+        }
         for i in 0..n {
             for j in i..n {
                 let mut s = 0.0;
                 for &(k, bk) in &cols[i][..cnt[i]] {
-                    for &(l, bl) in &cols[j][..cnt[j]] {
-                        s += bk * self.mbar[(k, l)] * bl;
-                    }
+                    s += bk * p[k * n + j];
                 }
                 out[i * n + j] = s;
                 out[j * n + i] = s;
             }
         }
+    }
+
+    /// A factor R = Ū B̂ (row-major nw × n) of the mass matrix, M = RᵀR
+    /// = B̂ᵀ M̄ B̂ (3.31) with M̄ = ŪᵀŪ. Returns the number of rows nw, or `None`
+    /// if M̄ is indefinite.
+    pub fn mass_factor(&self, x: &[f64], out: &mut [f64]) -> Option<usize> {
+        let ubar = self.ubar.as_ref()?;
+        let nxn = self.nx_nodes();
+        let nv = self.nv();
+        let nw = self.mbar.nrows();
+        let n = nxn + nw - nv;
+        let b = self.blocks(x);
+        for a in 0..nw {
+            let u = &ubar[a * nw..(a + 1) * nw];
+            let row = &mut out[a * n..(a + 1) * n];
+            for nd in 0..self.nodes {
+                let (o, v) = (7 * nd, 6 * nd);
+                for j in 0..3 {
+                    row[o + j] =
+                        u[v] * b.ft.0[0][j] + u[v + 1] * b.ft.0[1][j] + u[v + 2] * b.ft.0[2][j];
+                }
+                let g = &b.g[nd];
+                for k in 0..4 {
+                    row[o + 3 + k] = u[v + 3] * g[0][k] + u[v + 4] * g[1][k] + u[v + 5] * g[2][k];
+                }
+            }
+            row[nxn..n].copy_from_slice(&u[nv..nw]);
+        }
+        Some(nw)
     }
 
     /// Kinetic energy T = ½ wᵀ M̄ w.
@@ -331,9 +534,22 @@ pub(crate) struct PlanarInertia {
     pub variant: VelocityTransform,
     pub beta0: f64,
     pub mbar: DMatrix<f64>,
+    /// Ū with M̄ = ŪᵀŪ (row-major, upper triangular); `None` if M̄ is indefinite.
+    pub ubar: Option<Vec<f64>>,
 }
 
 impl PlanarInertia {
+    pub fn new(nodes: usize, variant: VelocityTransform, beta0: f64, mbar: DMatrix<f64>) -> Self {
+        let ubar = mbar_factor(&mbar);
+        Self {
+            nodes,
+            variant,
+            beta0,
+            mbar,
+            ubar,
+        }
+    }
+
     pub fn n(&self) -> usize {
         3 * self.nodes
     }
@@ -483,6 +699,26 @@ impl PlanarInertia {
         }
     }
 
+    /// A factor R = Ū B (row-major n × n) of the mass matrix, M = RᵀR with
+    /// M̄ = ŪᵀŪ; `None` if M̄ is indefinite.
+    pub fn mass_factor(&self, x: &[f64], out: &mut [f64]) -> Option<usize> {
+        let ubar = self.ubar.as_ref()?;
+        let n = self.n();
+        let beta = self.angle(x);
+        let (s, c) = beta.sin_cos();
+        // B per node: rows (u, v) = [c s; −s c] (ẋ, ẏ), row θ = φ̇
+        for a in 0..n {
+            for nd in 0..self.nodes {
+                let o = 3 * nd;
+                let (u0, u1, u2) = (ubar[a * n + o], ubar[a * n + o + 1], ubar[a * n + o + 2]);
+                out[a * n + o] = u0 * c - u1 * s;
+                out[a * n + o + 1] = u0 * s + u1 * c;
+                out[a * n + o + 2] = u2;
+            }
+        }
+        Some(n)
+    }
+
     pub fn kinetic_energy<T: Real>(&self, x: &[T], xd: &[T]) -> T {
         let n = self.n();
         let mut w = [T::zero(); 6];
@@ -494,5 +730,289 @@ impl PlanarInertia {
             e += w[i] * p[i];
         }
         e * 0.5
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::beam_matrices::{planar_beam_m_bar, spatial_beam_m_bar};
+    use crate::section::{Material, SectionShape};
+
+    /// A unit quaternion from a rotation vector.
+    fn quat(v: [f64; 3]) -> [f64; 4] {
+        let a = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let s = if a > 0.0 { (a / 2.0).sin() / a } else { 0.5 };
+        [(a / 2.0).cos(), v[0] * s, v[1] * s, v[2] * s]
+    }
+
+    fn beam_inertia(variant: VelocityTransform, modes: usize) -> SpatialInertia {
+        let mat = Material::from_poisson(2.1e11, 0.3, 7800.0);
+        let sec = SectionShape::Rectangle {
+            by: 0.03,
+            bz: 0.002,
+        }
+        .properties(0.3)
+        .unwrap();
+        let m12 = spatial_beam_m_bar(&mat, &sec, 0.2);
+        let nw = 12 + modes;
+        // modes: a positive-definite block coupled weakly to the nodes
+        let mbar = DMatrix::from_fn(nw, nw, |i, j| match (i < 12, j < 12) {
+            (true, true) => m12[(i, j)],
+            (false, false) if i == j => 0.01 * (1.0 + i as f64),
+            (false, false) => 1e-4,
+            // couple the modes to the translations only (M̄ stays definite)
+            (true, false) if [0, 1, 2, 6, 7, 8].contains(&i) => 1e-3 * ((i + j) % 5) as f64,
+            (false, true) if [0, 1, 2, 6, 7, 8].contains(&j) => 1e-3 * ((i + j) % 5) as f64,
+            _ => 0.0,
+        });
+        let r0 = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        SpatialInertia::new(2, variant, r0, mbar)
+    }
+
+    fn state(modes: usize) -> Vec<f64> {
+        let lp = quat([0.1, -0.2, 0.3]);
+        let lq = quat([-0.05, 0.25, 0.1]);
+        let mut x = vec![0.01, 0.02, -0.03];
+        x.extend(lp);
+        x.extend([0.21, -0.01, 0.02]);
+        x.extend(lq);
+        x.extend((0..modes).map(|k| 0.1 * k as f64));
+        x
+    }
+
+    /// The former formula: M_ij = Σ_kl B̂_ki M̄_kl B̂_lj over the sparse columns.
+    fn mass_reference(si: &SpatialInertia, x: &[f64]) -> Vec<f64> {
+        let nw = si.mbar.nrows();
+        let n = si.nx_nodes() + nw - si.nv();
+        let (cols, cnt) = si.bhat_columns(x);
+        let mut out = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                let mut s = 0.0;
+                for &(k, bk) in &cols[i][..cnt[i]] {
+                    for &(l, bl) in &cols[j][..cnt[j]] {
+                        s += bk * si.mbar[(k, l)] * bl;
+                    }
+                }
+                out[i * n + j] = s;
+            }
+        }
+        out
+    }
+
+    fn max_abs(v: &[f64]) -> f64 {
+        v.iter().fold(0.0f64, |m, a| m.max(a.abs()))
+    }
+
+    #[test]
+    fn spatial_mass_matches_the_reference_and_its_factor() {
+        for variant in [
+            VelocityTransform::B1,
+            VelocityTransform::B2,
+            VelocityTransform::B3,
+        ] {
+            for modes in [0, 3] {
+                let si = beam_inertia(variant, modes);
+                let x = state(modes);
+                let n = x.len();
+                let reference = mass_reference(&si, &x);
+                let mut m = vec![0.0; n * n];
+                si.mass(&x, &mut m);
+                let scale = max_abs(&reference);
+                let err: Vec<f64> = m.iter().zip(&reference).map(|(a, b)| a - b).collect();
+                assert!(
+                    max_abs(&err) < 1e-14 * scale,
+                    "{variant:?} {modes}: {} of {scale}",
+                    max_abs(&err)
+                );
+                // M = RᵀR
+                let mut r = vec![0.0; n * n];
+                let rows = si.mass_factor(&x, &mut r).unwrap();
+                assert_eq!(rows, 12 + modes);
+                for i in 0..n {
+                    for j in 0..n {
+                        let rtr: f64 = (0..rows).map(|k| r[k * n + i] * r[k * n + j]).sum();
+                        assert!(
+                            (rtr - reference[i * n + j]).abs() < 1e-13 * scale,
+                            "{variant:?} {modes} ({i}, {j}): {rtr} vs {}",
+                            reference[i * n + j]
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// The closed-form B*ᵀp against the dual pass, in f64 and in dual numbers
+    /// (as the force derivatives use it), also off the unit sphere.
+    #[test]
+    fn closed_form_bstar_matches_the_dual_pass() {
+        fn check<T: Real>(si: &SpatialInertia, x: &[T], xd: &[T], p: &[T]) {
+            let n = x.len();
+            let mut a = vec![T::zero(); n];
+            let mut b = vec![T::zero(); n];
+            assert!(si.bstar_t_p_sub(x, xd, p, &mut a));
+            si.bstar_t_p_sub_dual(x, xd, p, &mut b);
+            let scale = b.iter().fold(0.0f64, |m, v| m.max(v.value().abs()));
+            assert!(scale > 0.0);
+            for (u, v) in a.iter().zip(&b) {
+                assert!(
+                    (u.value() - v.value()).abs() < 1e-13 * scale,
+                    "{u:?} vs {v:?}"
+                );
+            }
+        }
+        let rb = {
+            let mut mbar = DMatrix::zeros(6, 6);
+            for a in 0..6 {
+                mbar[(a, a)] = 1.0;
+            }
+            SpatialInertia::new(
+                1,
+                VelocityTransform::B1,
+                [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]],
+                mbar,
+            )
+        };
+        let p: Vec<f64> = (0..15)
+            .map(|i| 0.3 + 0.17 * i as f64 - 0.02 * (i * i) as f64)
+            .collect();
+        for (si, modes) in [
+            (beam_inertia(VelocityTransform::B3, 0), 0),
+            (beam_inertia(VelocityTransform::B3, 3), 3),
+            (rb, 0),
+        ] {
+            let nodes = si.nodes;
+            for stretch in [1.0, 1.3] {
+                let mut x = state(modes);
+                x.truncate(7 * nodes);
+                for v in &mut x[3..7] {
+                    *v *= stretch;
+                }
+                if nodes == 2 {
+                    // λq in the other hemisphere
+                    for v in &mut x[10..14] {
+                        *v *= -0.9;
+                    }
+                }
+                x.extend((0..modes).map(|k| 0.1 * k as f64));
+                let xd: Vec<f64> = (0..x.len()).map(|i| 0.5 - 0.13 * i as f64).collect();
+                check(&si, &x, &xd, &p);
+                // with dual numbers: the derivatives agree as well
+                let xe: Vec<Dual<f64, 2>> = x
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| Dual::new(*v, [0.01 * i as f64, if i == 4 { 1.0 } else { 0.0 }]))
+                    .collect();
+                let xde: Vec<Dual<f64, 2>> =
+                    xd.iter().map(|v| Dual::new(*v, [0.3 * v, 1.0])).collect();
+                let pe: Vec<Dual<f64, 2>> = p.iter().map(|v| Dual::new(*v, [0.0, -v])).collect();
+                fn check_eps(
+                    si: &SpatialInertia,
+                    x: &[Dual<f64, 2>],
+                    xd: &[Dual<f64, 2>],
+                    p: &[Dual<f64, 2>],
+                ) {
+                    let n = x.len();
+                    let mut a = vec![Dual::<f64, 2>::constant(0.0); n];
+                    let mut b = vec![Dual::<f64, 2>::constant(0.0); n];
+                    si.bstar_t_p_sub(x, xd, p, &mut a);
+                    si.bstar_t_p_sub_dual(x, xd, p, &mut b);
+                    for (u, v) in a.iter().zip(&b) {
+                        for k in 0..2 {
+                            assert!(
+                                (u.eps[k] - v.eps[k]).abs() < 1e-12 * (1.0 + v.eps[k].abs()),
+                                "{u:?} vs {v:?}"
+                            );
+                        }
+                    }
+                }
+                check(&si, &xe, &xde, &pe);
+                check_eps(&si, &xe, &xde, &pe);
+            }
+        }
+    }
+
+    #[test]
+    fn rigid_body_factor_reproduces_the_mass() {
+        let mut mbar = DMatrix::zeros(6, 6);
+        for a in 0..3 {
+            mbar[(a, a)] = 2.0;
+            mbar[(3 + a, 3 + a)] = 0.1 + 0.05 * a as f64;
+        }
+        mbar[(1, 5)] = 0.2;
+        mbar[(5, 1)] = 0.2;
+        let si = SpatialInertia::new(
+            1,
+            VelocityTransform::B1,
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            mbar,
+        );
+        let x = {
+            let mut x = vec![0.3, -0.1, 0.2];
+            x.extend(quat([0.4, 0.1, -0.3]));
+            x
+        };
+        let mut m = vec![0.0; 49];
+        let mut r = vec![0.0; 49];
+        si.mass(&x, &mut m);
+        let reference = mass_reference(&si, &x);
+        let rows = si.mass_factor(&x, &mut r).unwrap();
+        for i in 0..7 {
+            for j in 0..7 {
+                let rtr: f64 = (0..rows).map(|k| r[k * 7 + i] * r[k * 7 + j]).sum();
+                assert!((rtr - m[i * 7 + j]).abs() < 1e-13, "({i}, {j})");
+                assert!(
+                    (reference[i * 7 + j] - m[i * 7 + j]).abs() < 1e-14,
+                    "({i}, {j})"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn planar_factor_reproduces_the_mass() {
+        let mat = Material::from_poisson(2.1e11, 0.3, 7800.0);
+        let sec = SectionShape::Rectangle {
+            by: 0.03,
+            bz: 0.002,
+        }
+        .properties(0.3)
+        .unwrap();
+        let mbar = DMatrix::from_iterator(6, 6, planar_beam_m_bar(&mat, &sec, 0.2).iter().copied());
+        for variant in [VelocityTransform::B1, VelocityTransform::B2] {
+            let pi = PlanarInertia::new(2, variant, 0.4, mbar.clone());
+            let x = [0.01, 0.02, 0.3, 0.2, 0.05, -0.2];
+            let mut m = [0.0; 36];
+            let mut r = [0.0; 36];
+            pi.mass(&x, &mut m);
+            let rows = pi.mass_factor(&x, &mut r).unwrap();
+            let scale = max_abs(&m);
+            for i in 0..6 {
+                for j in 0..6 {
+                    let rtr: f64 = (0..rows).map(|k| r[k * 6 + i] * r[k * 6 + j]).sum();
+                    assert!(
+                        (rtr - m[i * 6 + j]).abs() < 1e-13 * scale,
+                        "{variant:?} ({i}, {j})"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn psd_factor_handles_massless_directions_and_rejects_indefinite() {
+        // diag(2, 0, 3) with a coupling only between the massive entries
+        let a = [2.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.5, 0.0, 3.0];
+        let u = psd_factor(&a, 3).unwrap();
+        for i in 0..3 {
+            for j in 0..3 {
+                let v: f64 = (0..3).map(|k| u[k * 3 + i] * u[k * 3 + j]).sum();
+                assert!((v - a[i * 3 + j]).abs() < 1e-15, "({i}, {j})");
+            }
+        }
+        assert!(psd_factor(&[1.0, 2.0, 2.0, 1.0], 2).is_none());
+        assert!(psd_factor(&[0.0, 1.0, 1.0, 1.0], 2).is_none());
     }
 }
