@@ -145,6 +145,8 @@ pub struct Kinematics {
     /// local entry (a, c) in its values (`NO_ENTRY` when not in J).
     lu: JacobianLu,
     jpos: Vec<Vec<usize>>,
+    /// (element, local index) of the deformations that are not constraint rows.
+    free_deformations: Vec<(usize, usize)>,
     f: Mat<f64>,
     e: Mat<f64>,
     first_order_valid: bool,
@@ -232,6 +234,14 @@ impl Kinematics {
             .collect();
         let n_xi = n_q + n_u;
         let (lu, jpos) = jacobian_pattern(&maps, n_c, dense_up_to);
+        let free_deformations = mech
+            .elements
+            .iter()
+            .enumerate()
+            .flat_map(|(k, e)| (0..maps[k].ne).map(move |a| (k, a, e.eps_offset + a)))
+            .filter(|&(_, _, j)| row_of[j].is_none())
+            .map(|(k, a, _)| (k, a))
+            .collect();
         let mut s = Self {
             opts: NewtonOptions::default(),
             maps,
@@ -250,6 +260,7 @@ impl Kinematics {
             jac_local,
             lu,
             jpos,
+            free_deformations,
             f: Mat::zeros(n_x, n_xi),
             e: Mat::zeros(n_eps, n_xi),
             first_order_valid: false,
@@ -705,7 +716,8 @@ impl Kinematics {
             }
         }
         self.lu.solve_in_place(self.rhs.as_mut());
-        self.f.fill(0.0);
+        // rows of fixed coordinates stay zero and those of ξ stay unit: only
+        // the dependent rows change (F and E start as zeros)
         for c in 0..n_xi {
             let src = self.rhs.col_as_slice(c);
             let dst = self.f.col_as_slice_mut(c);
@@ -718,29 +730,25 @@ impl Kinematics {
                 self.f[(i, *k)] = 1.0;
             }
         }
-        // E,ξ = D,x F,ξ; exact for rigid / DOF / input rows
-        self.e.fill(0.0);
-        for col in 0..n_xi {
-            let fcol = self.f.col_as_slice(col);
-            let ecol = self.e.col_as_slice_mut(col);
-            for (ei, e) in self.mech.elements.iter().enumerate() {
-                let m = &self.maps[ei];
-                let jl = &self.jac_local[ei];
-                for a in 0..m.ne {
-                    let j = e.eps_offset + a;
-                    if self.row_of[j].is_some() {
-                        if self.xi_of_e[j] == Some(col) {
-                            ecol[j] = 1.0;
-                        }
-                        continue;
-                    }
-                    let row = &jl[a * m.nx..(a + 1) * m.nx];
-                    let mut s = 0.0;
-                    for (c, gi) in e.x_index.iter().enumerate() {
-                        s += row[c] * fcol[*gi];
-                    }
-                    ecol[j] = s;
+        // E,ξ = D,x F,ξ on the deformations that are not constraint rows;
+        // exact (zero or unit) on rigid / DOF / input rows
+        for (j, k) in self.xi_of_e.iter().enumerate() {
+            if let (Some(k), Some(_)) = (k, self.row_of[j]) {
+                self.e[(j, *k)] = 1.0;
+            }
+        }
+        for &(ei, a) in &self.free_deformations {
+            let e = &self.mech.elements[ei];
+            let nx = self.maps[ei].nx;
+            let row = &self.jac_local[ei][a * nx..(a + 1) * nx];
+            let j = e.eps_offset + a;
+            for col in 0..n_xi {
+                let fcol = self.f.col_as_slice(col);
+                let mut s = 0.0;
+                for (c, gi) in e.x_index.iter().enumerate() {
+                    s += row[c] * fcol[*gi];
                 }
+                self.e[(j, col)] = s;
             }
         }
         self.first_order_valid = true;
