@@ -703,18 +703,9 @@ impl Kinematics {
             }
         }
         // nodal coordinates in ξ: −∂D_c/∂x_i
-        for (ei, e) in self.mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
-            for (c, gi) in e.x_index.iter().enumerate() {
-                let Some(k) = self.xi_of_x[*gi] else { continue };
-                for (a, r) in m.rows.iter().enumerate() {
-                    if let Some(r) = r {
-                        self.rhs[(*r, k)] -= jl[a * m.nx + c];
-                    }
-                }
-            }
-        }
+        let mut rhs = std::mem::replace(&mut self.rhs, Mat::new());
+        self.for_each_nodal_xi_entry(|r, k, d| rhs[(r, k)] -= d);
+        self.rhs = rhs;
         self.lu.solve_in_place(self.rhs.as_mut());
         // rows of fixed coordinates stay zero and those of ξ stay unit: only
         // the dependent rows change (F and E start as zeros)
@@ -754,6 +745,24 @@ impl Kinematics {
         self.first_order_valid = true;
     }
 
+    /// Visits the entries ∂D_r/∂x_i of the constraint rows r with respect to
+    /// the nodal coordinates x_i that belong to ξ (k = ξ index of x_i): the
+    /// nodal columns of the right-hand side B of (5.8a), up to sign.
+    fn for_each_nodal_xi_entry(&self, mut visit: impl FnMut(usize, usize, f64)) {
+        for (ei, e) in self.mech.elements.iter().enumerate() {
+            let m = &self.maps[ei];
+            let jl = &self.jac_local[ei];
+            for (c, gi) in e.x_index.iter().enumerate() {
+                let Some(k) = self.xi_of_x[*gi] else { continue };
+                for (a, r) in m.rows.iter().enumerate() {
+                    if let Some(r) = r {
+                        visit(*r, k, jl[a * m.nx + c]);
+                    }
+                }
+            }
+        }
+    }
+
     /// F,ξᵀ y for a vector y over the nodal coordinates, at the last solved
     /// configuration, by one adjoint solve with Jᵀ and without forming F,ξ:
     /// with F,ξ = J⁻¹B on the dependent coordinates (thesis (5.8a)),
@@ -773,18 +782,7 @@ impl Kinematics {
                 out[*k] += y[i];
             }
         }
-        for (ei, e) in mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
-            for (c, gi) in e.x_index.iter().enumerate() {
-                let Some(k) = self.xi_of_x[*gi] else { continue };
-                for (a, r) in m.rows.iter().enumerate() {
-                    if let Some(r) = r {
-                        out[k] -= jl[a * m.nx + c] * mu[*r];
-                    }
-                }
-            }
-        }
+        self.for_each_nodal_xi_entry(|r, k, d| out[k] -= d * mu[r]);
         // deformation coordinates in ξ: a unit entry on their row
         for (j, k) in self.xi_of_e.iter().enumerate() {
             if let (Some(k), Some(r)) = (k, self.row_of[j]) {
