@@ -746,7 +746,8 @@ mod tests {
         [(a / 2.0).cos(), v[0] * s, v[1] * s, v[2] * s]
     }
 
-    fn beam_inertia(variant: VelocityTransform, modes: usize) -> SpatialInertia {
+    /// The steel strip (30 × 2 mm) the inertia tests are built on.
+    fn steel_strip() -> (Material, crate::SectionProperties) {
         let mat = Material::from_poisson(2.1e11, 0.3, 7800.0);
         let sec = SectionShape::Rectangle {
             by: 0.03,
@@ -754,6 +755,11 @@ mod tests {
         }
         .properties(0.3)
         .unwrap();
+        (mat, sec)
+    }
+
+    fn beam_inertia(variant: VelocityTransform, modes: usize) -> SpatialInertia {
+        let (mat, sec) = steel_strip();
         let m12 = spatial_beam_m_bar(&mat, &sec, 0.2);
         let nw = 12 + modes;
         // modes: a positive-definite block coupled weakly to the nodes
@@ -973,13 +979,7 @@ mod tests {
 
     #[test]
     fn planar_factor_reproduces_the_mass() {
-        let mat = Material::from_poisson(2.1e11, 0.3, 7800.0);
-        let sec = SectionShape::Rectangle {
-            by: 0.03,
-            bz: 0.002,
-        }
-        .properties(0.3)
-        .unwrap();
+        let (mat, sec) = steel_strip();
         let mbar = DMatrix::from_iterator(6, 6, planar_beam_m_bar(&mat, &sec, 0.2).iter().copied());
         for variant in [VelocityTransform::B1, VelocityTransform::B2] {
             let pi = PlanarInertia::new(2, variant, 0.4, mbar.clone());
