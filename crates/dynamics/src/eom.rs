@@ -12,6 +12,7 @@ use faer::{Accum, Mat, MatMut, MatRef, Par};
 use flexmb_element::Element;
 use flexmb_kinematics::Kinematics;
 use flexmb_model::{Coordinate, ERole, Load, Mechanism};
+use crate::nodal_eom::NodalEom;
 use flexmb_rotation::EulerParameters;
 use std::sync::Arc;
 
@@ -227,6 +228,8 @@ pub struct Dynamics {
     pub(crate) rhs: Vec<f64>,
     /// Work arrays of the element-block assembly of Mq.
     asm: Assembly,
+    /// Set-up and work memory of the nodal-coordinate solve of q̈.
+    pub(crate) nodal: NodalEom,
     /// The Cholesky factor of Mq (lower triangle) and its workspace.
     llt: Mat<f64>,
     llt_mem: MemBuffer,
@@ -251,6 +254,7 @@ impl Dynamics {
             mq: Mat::zeros(n_q, n_q),
             rhs: vec![0.0; n_q],
             asm: Assembly::new(&mech),
+            nodal: NodalEom::new(&mech),
             llt: Mat::zeros(n_q, n_q),
             llt_mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(
                 n_q,
@@ -315,6 +319,12 @@ impl Dynamics {
     /// deformations; zero on rigid and prescribed deformations) at the current
     /// kinematic state. `with_rates`: include ε̇/ẋ terms (damping, D-action).
     pub(crate) fn forces(&mut self, t: f64, with_rates: bool) {
+        self.forces_with(t, with_rates, true);
+    }
+
+    /// As [`forces`](Self::forces); without gravity in f when `gravity` is
+    /// false (the nodal solve applies it as an acceleration field).
+    pub(crate) fn forces_with(&mut self, t: f64, with_rates: bool, gravity: bool) {
         let mech = self.mech.clone();
         let x = self.kin.x();
         let eps = self.kin.eps();
@@ -342,7 +352,7 @@ impl Dynamics {
                 }
             }
         }
-        if let Some(g0) = mech.gravity {
+        if let (Some(g0), true) = (mech.gravity, gravity) {
             // the load scale of a load sweep does not scale gravity
             let g = g0.map(|v| v * self.load_factor);
             let mut xl = [0.0; 64];
@@ -470,8 +480,19 @@ impl Dynamics {
         matmul(rhs, Accum::Add, eq.transpose(), sigma, -1.0, Par::Seq);
     }
 
-    /// The equations of motion (D.10) solved for q̈ at (t, q, q̇): Cholesky of
-    /// Mq in a preallocated buffer, then two triangular solves.
+    /// The equations of motion (D.10) solved for q̈ at (t, q, q̇): one
+    /// evaluation of the right-hand side of the integrators.
+    ///
+    /// Solved in nodal coordinates with multipliers for the constraint
+    /// deformations (see the `nodal_eom` module): the same q̈ as the
+    /// projection on the degrees of freedom
+    /// ([`accelerations_by_projection`](Self::accelerations_by_projection)),
+    /// without forming F,q or Mq. The position solve keeps the factorization
+    /// of the kinematic Jacobian while chord steps converge fast, and the
+    /// velocities are refined against the exact Jacobian. If the nodal
+    /// system cannot be solved (a motion without inertia, dependent
+    /// constraints) the projection is used, whose errors name the
+    /// coordinates.
     pub fn accelerations(
         &mut self,
         t: f64,
@@ -480,6 +501,62 @@ impl Dynamics {
         qdd: &mut [f64],
     ) -> Result<(), DynamicsError> {
         self.evaluations += 1;
+        let n = self.n_q();
+        if !self.nodal_accelerations(t, q, qd, &mut qdd[..n])? {
+            return self.accelerations_by_projection(t, q, qd, qdd);
+        }
+        if let Some(i) = qdd[..n].iter().position(|v| !v.is_finite()) {
+            return Err(DynamicsError::NonFinite {
+                what: "q̈",
+                index: i,
+                t,
+            });
+        }
+        Ok(())
+    }
+
+    /// q̈ by the nodal solve; false if that system is not solvable.
+    pub(crate) fn nodal_accelerations(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &mut [f64],
+    ) -> Result<bool, DynamicsError> {
+        let kin_err = |e| DynamicsError::Kinematics { t, source: e };
+        self.kin.solve_chord(q, t).map_err(kin_err)?;
+        if let Some(i) = qd.iter().position(|v| !v.is_finite()) {
+            return Err(DynamicsError::NonFinite {
+                what: "q̇",
+                index: i,
+                t,
+            });
+        }
+        self.kin.velocities_refined(qd).map_err(kin_err)?;
+        self.kin.convective_terms();
+        self.forces_with(t, true, false);
+        let g = self
+            .mech
+            .gravity
+            .map(|g0| g0.map(|v| v * self.load_factor));
+        Ok(self
+            .nodal
+            .accelerations(&self.kin, &self.mech, t, &self.f, &self.sigma, g, qdd)
+            .is_ok())
+    }
+
+    /// The equations of motion (D.10) solved for q̈ by the projection on the
+    /// degrees of freedom: Mq = F,qᵀMxF,q assembled element by element, its
+    /// Cholesky factor in a preallocated buffer, two triangular solves. The
+    /// reference for [`accelerations`](Self::accelerations) (which counts
+    /// evaluations; this does not).
+    pub fn accelerations_by_projection(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &mut [f64],
+    ) -> Result<(), DynamicsError> {
         self.kinematics_at(t, q, Some(qd))?;
         self.forces(t, true);
         self.inertia(true);

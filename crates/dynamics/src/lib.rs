@@ -36,8 +36,10 @@
 
 mod eom;
 mod linearize;
+mod nodal_eom;
 mod outputs;
 mod simulate;
+mod skyline;
 mod statics;
 
 pub use eom::{Dynamics, Energies};

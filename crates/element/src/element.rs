@@ -566,6 +566,10 @@ impl Element {
     pub fn damping(&self) -> Option<&DMatrix<f64>> {
         self.damping.as_ref()
     }
+    /// True for the Euler-parameter normalization λᵀλ − 1 of a node.
+    pub fn is_normalization(&self) -> bool {
+        matches!(self.kind, Kind::Normalization)
+    }
     /// A short name of the element type.
     pub fn type_name(&self) -> &'static str {
         match &self.kind {

@@ -449,9 +449,29 @@ impl SpatialInertia {
         let nw = self.mbar.nrows();
         let n = nxn + nw - nv;
         let (cols, cnt) = self.bhat_columns(x);
+        // P row-major nw × n; a beam's (12 × 14) fits a small array, whose
+        // zeroing is a tenth of the one sized for the most modes
+        const SMALL: usize = 12 * 14;
+        if nw * n <= SMALL {
+            let mut p = [0.0f64; SMALL];
+            self.mass_from_columns(&cols, &cnt, n, &mut p[..nw * n], out);
+        } else {
+            let mut p = [0.0f64; MAX_W * (14 + MAX_MODES)];
+            self.mass_from_columns(&cols, &cnt, n, &mut p[..nw * n], out);
+        }
+    }
+
+    /// M = B̂ᵀ (M̄ B̂) from the columns of B̂, with `p` (zeroed, nw × n) for M̄ B̂.
+    fn mass_from_columns(
+        &self,
+        cols: &[[(usize, f64); 3]],
+        cnt: &[usize],
+        n: usize,
+        p: &mut [f64],
+        out: &mut [f64],
+    ) {
+        let nw = self.mbar.nrows();
         let mbar = self.mbar.as_slice(); // column-major: M̄[:, k] is contiguous
-                                         // P row-major nw × n
-        let mut p = [0.0f64; MAX_W * (14 + MAX_MODES)];
         for j in 0..n {
             for &(k, bk) in &cols[j][..cnt[j]] {
                 let mk = &mbar[k * nw..(k + 1) * nw];

@@ -242,10 +242,15 @@ impl JacobianLu {
         }
     }
 
-    /// Solves J X = B in place (B: n × k). Does nothing before a successful
-    /// [`factor`](Self::factor).
-    pub fn solve_in_place(&mut self, b: MatMut<'_, f64>) {
-        if !self.factored || self.n == 0 || b.ncols() == 0 {
+    /// Solves J X = B in place (B: n × k). Before a successful
+    /// [`factor`](Self::factor) (or after a failed one) B becomes NaN, so a
+    /// solve with a singular J can never pass for a result.
+    pub fn solve_in_place(&mut self, mut b: MatMut<'_, f64>) {
+        if self.n == 0 || b.ncols() == 0 {
+            return;
+        }
+        if !self.factored {
+            b.fill(f64::NAN);
             return;
         }
         if let Some(d) = &self.dense {
@@ -264,9 +269,13 @@ impl JacobianLu {
         );
     }
 
-    /// Solves Jᵀ X = B in place.
-    pub fn solve_transpose_in_place(&mut self, b: MatMut<'_, f64>) {
-        if !self.factored || self.n == 0 || b.ncols() == 0 {
+    /// Solves Jᵀ X = B in place (NaN without a successful factorization).
+    pub fn solve_transpose_in_place(&mut self, mut b: MatMut<'_, f64>) {
+        if self.n == 0 || b.ncols() == 0 {
+            return;
+        }
+        if !self.factored {
+            b.fill(f64::NAN);
             return;
         }
         if let Some(d) = &self.dense {

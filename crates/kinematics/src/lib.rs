@@ -166,9 +166,41 @@ pub struct Kinematics {
     x_good: Vec<f64>,
     xi_good: Vec<f64>,
     lu_valid: bool,
+    /// The factorization of J is of the current x (not of an earlier one).
+    lu_at_x: bool,
+    /// Factorizations of J so far.
+    factorizations: u64,
+    /// Iterative-refinement steps of velocity solves so far.
+    refinements: u64,
     dx: Vec<f64>,
     rhs_vec: Vec<f64>,
+    last_update: Vec<f64>,
+    /// D,xx\[ẋ, ẋ\] of every deformation, after [`convective_terms`](Kinematics::convective_terms).
+    dxx_vv: Vec<f64>,
+    /// Right-hand side and residual of the refined velocity solve.
+    vel_rhs: Vec<f64>,
+    vel_res: Vec<f64>,
 }
+
+/// When the position solve factorizes the kinematic Jacobian at the
+/// converged configuration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Refactor {
+    /// Always (F,ξ and every other derivative solve need J there).
+    AtSolution,
+    /// Only when chord steps converge slowly: the factorization may be of a
+    /// nearby configuration, for solves that refine against the exact J.
+    WhenSlow,
+}
+
+/// Iterative-refinement steps of a velocity solve with a factorization of
+/// a nearby configuration before J is factorized afresh at x. Each step costs
+/// a product with J and a solve, about a tenth of a factorization of the
+/// 77 × 77 Jacobian of the spatial guidance; with a factorization a few steps
+/// old the updates shrink by 1e-4 to 1e-6 per step (measured), so three steps
+/// reach 1e-14, and a slower contraction means the factorization is too old:
+/// a fresh one then also serves the next evaluations.
+const MAX_REFINEMENTS: usize = 3;
 
 /// Marks a local Jacobian entry that is not part of J.
 const NO_ENTRY: usize = usize::MAX;
@@ -277,8 +309,15 @@ impl Kinematics {
             x_good: mech.x0.clone(),
             xi_good: vec![0.0; n_xi],
             lu_valid: false,
+            lu_at_x: false,
+            factorizations: 0,
+            refinements: 0,
             dx: vec![0.0; n_c],
             rhs_vec: vec![0.0; n_c],
+            last_update: vec![0.0; n_c],
+            dxx_vv: vec![0.0; n_eps],
+            vel_rhs: vec![0.0; n_c],
+            vel_res: vec![0.0; n_c],
             mech,
         };
         s.xi[..n_q].copy_from_slice(&s.mech.q0());
@@ -342,6 +381,11 @@ impl Kinematics {
     pub fn epsdd0(&self) -> &[f64] {
         &self.epsdd0
     }
+    /// D,xx\[ẋ, ẋ\] of every deformation, from the last
+    /// [`convective_terms`](Self::convective_terms) call.
+    pub fn convective(&self) -> &[f64] {
+        &self.dxx_vv
+    }
     /// The local deformation Jacobian D,x of element `k` (row-major), at the last solve.
     pub fn element_jacobian(&self, k: usize) -> &[f64] {
         &self.jac_local[k]
@@ -352,6 +396,18 @@ impl Kinematics {
     pub fn set_guess(&mut self, x: &[f64]) {
         self.x.copy_from_slice(x);
         self.have_solution = false;
+        self.lu_at_x = false;
+    }
+
+    /// Factorizations of the kinematic Jacobian so far (a cost measure).
+    pub fn factorizations(&self) -> u64 {
+        self.factorizations
+    }
+
+    /// Iterative-refinement steps of [`velocities_refined`](Self::velocities_refined)
+    /// so far (each one product with J and one solve).
+    pub fn refinements(&self) -> u64 {
+        self.refinements
     }
 
     fn eval_elements(&mut self, with_jac: bool) {
@@ -456,7 +512,22 @@ impl Kinematics {
     /// (prescribed inputs from their time functions). Starts from the last
     /// solution, extrapolated to first order with F,ξ when available.
     pub fn solve(&mut self, q: &[f64], t: f64) -> Result<(), KinematicsError> {
-        let r = self.solve_inner(q, t);
+        self.solve_with(q, t, Refactor::AtSolution)
+    }
+
+    /// As [`solve`](Self::solve), but without factorizing J at the converged
+    /// configuration when chord steps converged fast: for callers that need
+    /// only the configuration, the element Jacobians and solves that refine
+    /// against the exact J ([`velocities_refined`](Self::velocities_refined)),
+    /// as one evaluation of the equations of motion in nodal coordinates
+    /// does. Every method that needs J factorized at x (F,ξ, adjoint and
+    /// sensitivity solves) factorizes it first if it is not.
+    pub fn solve_chord(&mut self, q: &[f64], t: f64) -> Result<(), KinematicsError> {
+        self.solve_with(q, t, Refactor::WhenSlow)
+    }
+
+    fn solve_with(&mut self, q: &[f64], t: f64, mode: Refactor) -> Result<(), KinematicsError> {
+        let r = self.solve_inner(q, t, mode);
         match &r {
             Ok(()) => {
                 self.x_good.copy_from_slice(&self.x);
@@ -464,18 +535,21 @@ impl Kinematics {
             }
             Err(_) => {
                 self.lu_valid = false;
+                self.lu_at_x = false;
                 // back to the last converged configuration: the next solve
                 // (e.g. a retried, smaller step) starts from a good guess
                 self.x.copy_from_slice(&self.x_good);
                 self.xi.copy_from_slice(&self.xi_good);
                 self.have_solution = true;
                 self.first_order_valid = false;
+                // deformations and element Jacobians of that configuration
+                self.eval_elements(true);
             }
         }
         r
     }
 
-    fn solve_inner(&mut self, q: &[f64], t: f64) -> Result<(), KinematicsError> {
+    fn solve_inner(&mut self, q: &[f64], t: f64, mode: Refactor) -> Result<(), KinematicsError> {
         if let Some(i) = q.iter().position(|v| !v.is_finite()) {
             return Err(KinematicsError::NonFinite {
                 what: "q",
@@ -488,7 +562,7 @@ impl Kinematics {
             target.push(self.mech.inputs[k].function.value(t));
         }
         self.t = t;
-        let first = self.solve_xi(&target);
+        let first = self.solve_xi(&target, mode);
         if first.is_ok() || matches!(first, Err(KinematicsError::EulerParameterDegenerate { .. })) {
             return first;
         }
@@ -510,7 +584,8 @@ impl Kinematics {
                     .zip(&target)
                     .map(|(a, b)| a + s * (b - a))
                     .collect();
-                if let Err(e) = self.solve_xi(&mid) {
+                // intermediate solutions feed the F,ξ predictor: J at each
+                if let Err(e) = self.solve_xi(&mid, Refactor::AtSolution) {
                     err = Err(e);
                     ok = false;
                     break;
@@ -525,31 +600,17 @@ impl Kinematics {
     }
 
     /// One Newton solve for the full ξ = (q, u).
-    fn solve_xi(&mut self, xi: &[f64]) -> Result<(), KinematicsError> {
-        let (n_q, n_u) = (self.n_q, self.n_u);
+    ///
+    /// Chord Newton: the factorization of J is kept from step to step (and
+    /// from the previous solve) while the residual shrinks at least tenfold
+    /// per step, and refactorized at the current x otherwise. With
+    /// [`Refactor::AtSolution`] J is also factorized at the converged point
+    /// (F,ξ needs it there); with [`Refactor::WhenSlow`] the last factorization
+    /// may be of a nearby configuration, and `lu_at_x` says whether it is not.
+    fn solve_xi(&mut self, xi: &[f64], mode: Refactor) -> Result<(), KinematicsError> {
+        let n_q = self.n_q;
         self.xi_prev.copy_from_slice(&self.xi);
         self.xi.copy_from_slice(xi);
-        // first-order predictor x += F,ξ Δξ
-        if self.first_order_valid && self.have_solution {
-            for c in 0..n_q + n_u {
-                let d = self.xi[c] - self.xi_prev[c];
-                if d != 0.0 {
-                    for &i in &self.mech.dependent {
-                        self.x[i] += self.f[(i, c)] * d;
-                    }
-                }
-            }
-        }
-        self.first_order_valid = false;
-        // known coordinates
-        for (i, r) in self.mech.x_roles.iter().enumerate() {
-            match r {
-                XRole::Fixed => self.x[i] = self.mech.x0[i],
-                XRole::Dof(k) => self.x[i] = self.xi[*k],
-                XRole::Input(k) => self.x[i] = self.xi[n_q + k],
-                XRole::Dependent(_) => {}
-            }
-        }
         // targets of the constraint rows
         for (r, j) in self.mech.constraint_rows.iter().enumerate() {
             self.target[r] = match self.mech.e_roles[*j] {
@@ -558,23 +619,34 @@ impl Kinematics {
                 _ => 0.0,
             };
         }
+        let mut moved = self.have_solution && self.predict();
+        self.first_order_valid = false;
+        // known coordinates
+        for (i, r) in self.mech.x_roles.iter().enumerate() {
+            let v = match r {
+                XRole::Fixed => self.mech.x0[i],
+                XRole::Dof(k) => self.xi[*k],
+                XRole::Input(k) => self.xi[n_q + k],
+                XRole::Dependent(_) => continue,
+            };
+            if self.x[i] != v {
+                self.x[i] = v;
+                moved = true;
+            }
+        }
+        if moved {
+            self.lu_at_x = false;
+        }
         let tol = self.opts.tol * self.length_scale.max(1e-6);
         let n_c = self.mech.constraint_rows.len();
-        let mut last_update: Vec<f64> = vec![0.0; n_c];
-        // Newton with the Jacobian of the previous solve (chord steps) while it
-        // converges fast, refactorized when it does not and always at the
-        // converged point (F,ξ needs J there).
-        let mut factored_here = false;
+        let mut last_update = std::mem::take(&mut self.last_update);
+        last_update.fill(0.0);
         let mut lu_fresh_for_steps = self.lu_valid;
         let mut prev_res = f64::INFINITY;
+        self.eval_elements(true);
+        let mut res = self.load_residual();
+        let mut outcome = None;
         for it in 0..=self.opts.max_iterations {
-            self.eval_elements(true);
-            let mut res = 0.0f64;
-            for (r, j) in self.mech.constraint_rows.iter().enumerate() {
-                let v = self.eps[*j] - self.target[r];
-                self.work[r] = -v;
-                res = res.max(v.abs());
-            }
             if !res.is_finite() {
                 break;
             }
@@ -589,64 +661,136 @@ impl Kinematics {
                 && last_update.iter().fold(0.0f64, |m, v| m.max(v.abs()))
                     <= 8.0 * f64::EPSILON * x_scale
                 && res <= 1e3 * tol.max(1e-300);
-            let converged = res <= tol || stalled;
-            // a fresh factorization at this x: at convergence, at the start
-            // without a usable one, or when chord steps converge slowly
-            if converged || !lu_fresh_for_steps || (it > 0 && res > 0.1 * prev_res) {
-                self.assemble_jacobian();
-                if !self.lu.factor() {
-                    self.lu_valid = false;
-                    return Err(self.singular_error());
-                }
-                self.lu_valid = true;
-                lu_fresh_for_steps = true;
-                factored_here = true;
-            }
-            if converged {
-                debug_assert!(factored_here);
-                self.check_euler_parameters()?;
-                self.iterations = it;
-                self.prev_eps.copy_from_slice(&self.eps);
-                self.have_solution = true;
-                return Ok(());
+            if res <= tol || stalled {
+                outcome = Some(self.converged(it, mode));
+                break;
             }
             if it == self.opts.max_iterations {
                 break;
             }
+            // a fresh factorization at this x: without a usable one, or when
+            // chord steps converge slowly
+            if !lu_fresh_for_steps || (it > 0 && res > 0.1 * prev_res) {
+                if let Err(e) = self.factor_at_x() {
+                    outcome = Some(Err(e));
+                    break;
+                }
+                lu_fresh_for_steps = true;
+            }
             prev_res = res;
             self.dx[..n_c].copy_from_slice(&self.work[..n_c]);
             self.lu.solve_vec(&mut self.dx[..n_c]);
-            let dx = std::mem::take(&mut self.dx);
-            // step with backtracking: halve while the residual grows
+            // step with backtracking: halve while the residual grows; the trial
+            // evaluation (with Jacobians) serves the next iteration
             let mut step = 1.0;
-            for _ in 0..6 {
-                for (k, &i) in self.mech.dependent.iter().enumerate() {
-                    self.x[i] += step * dx[k];
-                }
-                self.eval_elements(false);
+            loop {
+                self.add_to_dependent(step);
+                self.eval_elements(true);
                 let trial = self.residual_norm();
-                if trial.is_finite() && (trial < res || res < 1e3 * tol) {
+                if (trial.is_finite() && (trial < res || res < 1e3 * tol)) || step < 0.04 {
+                    // the smallest step is accepted anyway: Newton may still recover
                     break;
                 }
-                for (k, &i) in self.mech.dependent.iter().enumerate() {
-                    self.x[i] -= step * dx[k];
-                }
+                self.add_to_dependent(-step);
                 step *= 0.5;
-                if step < 0.04 {
-                    // accept the smallest step: Newton may still recover
-                    for (k, &i) in self.mech.dependent.iter().enumerate() {
-                        self.x[i] += step * dx[k];
+            }
+            self.lu_at_x = false;
+            for (u, d) in last_update.iter_mut().zip(&self.dx) {
+                *u = d * step;
+            }
+            res = self.load_residual();
+        }
+        let result = match outcome {
+            Some(r) => r,
+            None => Err(self.not_converged(&last_update)),
+        };
+        self.last_update = last_update;
+        result
+    }
+
+    /// x_dep += s · dx.
+    fn add_to_dependent(&mut self, s: f64) {
+        for (k, &i) in self.mech.dependent.iter().enumerate() {
+            self.x[i] += s * self.dx[k];
+        }
+    }
+
+    /// Writes −(D_c(x) − target) to `work` and returns its max-norm.
+    fn load_residual(&mut self) -> f64 {
+        let mut res = 0.0f64;
+        for (r, j) in self.mech.constraint_rows.iter().enumerate() {
+            let v = self.eps[*j] - self.target[r];
+            self.work[r] = -v;
+            res = res.max(v.abs());
+        }
+        res
+    }
+
+    /// Bookkeeping of a converged solve (and the factorization `mode` asks for).
+    fn converged(&mut self, it: usize, mode: Refactor) -> Result<(), KinematicsError> {
+        if mode == Refactor::AtSolution && !self.lu_at_x {
+            self.factor_at_x()?;
+        }
+        self.check_euler_parameters()?;
+        self.iterations = it;
+        self.prev_eps.copy_from_slice(&self.eps);
+        self.have_solution = true;
+        Ok(())
+    }
+
+    /// Factorizes J at the current x (element Jacobians evaluated there).
+    fn factor_at_x(&mut self) -> Result<(), KinematicsError> {
+        self.assemble_jacobian();
+        self.factorizations += 1;
+        if !self.lu.factor() {
+            self.lu_valid = false;
+            self.lu_at_x = false;
+            return Err(self.singular_error());
+        }
+        self.lu_valid = true;
+        self.lu_at_x = true;
+        Ok(())
+    }
+
+    /// First-order predictor of the dependent coordinates for the change of
+    /// ξ since the last solution: x += F,ξ Δξ when F,ξ is at hand, else one
+    /// chord step J Δx_dep = (target − D_c) − D_c,x_ξ Δx_ξ with the last
+    /// factorization and the element Jacobians of the last solution (the same
+    /// step to first order). Returns whether x changed.
+    fn predict(&mut self) -> bool {
+        let n_xi = self.n_q + self.n_u;
+        let mut moved = false;
+        if self.first_order_valid {
+            for c in 0..n_xi {
+                let d = self.xi[c] - self.xi_prev[c];
+                if d != 0.0 {
+                    moved = true;
+                    for &i in &self.mech.dependent {
+                        self.x[i] += self.f[(i, c)] * d;
                     }
-                    break;
                 }
             }
-            for (k, u) in last_update.iter_mut().enumerate() {
-                *u = dx[k] * step;
-            }
-            self.dx = dx;
-            factored_here = false;
+            return moved;
         }
-        // failure report
+        if !self.lu_valid || self.xi == self.xi_prev {
+            return false;
+        }
+        let mut rhs = std::mem::take(&mut self.dx);
+        for (r, j) in self.mech.constraint_rows.iter().enumerate() {
+            rhs[r] = self.target[r] - self.eps[*j];
+        }
+        let (xi, xi_prev) = (&self.xi, &self.xi_prev);
+        self.for_each_nodal_xi_entry(|r, k, d| rhs[r] -= d * (xi[k] - xi_prev[k]));
+        self.lu.solve_vec(&mut rhs);
+        for (k, &i) in self.mech.dependent.iter().enumerate() {
+            self.x[i] += rhs[k];
+        }
+        self.dx = rhs;
+        true
+    }
+
+    /// The failure report of a position solve that did not converge.
+    fn not_converged(&self, last_update: &[f64]) -> KinematicsError {
         let mut eq: Vec<(f64, String)> = self
             .mech
             .constraint_rows
@@ -674,7 +818,7 @@ impl Kinematics {
             .collect();
         co.sort_by(|a, b| b.0.total_cmp(&a.0));
         let residual = eq.first().map_or(f64::NAN, |e| e.0);
-        Err(KinematicsError::NotConverged {
+        KinematicsError::NotConverged {
             iterations: self.opts.max_iterations,
             residual,
             equations: eq
@@ -687,12 +831,21 @@ impl Kinematics {
                 .take(5)
                 .map(|(v, n)| format!("{n} ({v:.3e})"))
                 .collect(),
-        })
+        }
+    }
+    /// Factorizes J at the solved configuration if its factorization is of
+    /// another one (after [`solve_chord`](Self::solve_chord)). A singular J
+    /// leaves the factorization invalid and every later solve NaN.
+    fn ensure_lu_at_x(&mut self) {
+        if self.have_solution && !self.lu_at_x {
+            let _ = self.factor_at_x();
+        }
     }
 
     /// F,ξ and E,ξ at the last solved configuration, from the factorization of
     /// the last Newton iteration (thesis (5.8a), (6.6a)).
     pub fn first_order(&mut self) {
+        self.ensure_lu_at_x();
         let (n_q, n_u) = (self.n_q, self.n_u);
         let n_xi = n_q + n_u;
         self.rhs.fill(0.0);
@@ -769,6 +922,7 @@ impl Kinematics {
     /// F,ξᵀy = y_ξ + Bᵀ(J⁻ᵀ y_dep), B the right-hand side of
     /// [`first_order`](Self::first_order). `out` has n_q + n_u entries.
     pub fn transfer_transpose_times(&mut self, y: &[f64], out: &mut [f64]) {
+        self.ensure_lu_at_x();
         let mech = self.mech.clone();
         let mut mu = std::mem::take(&mut self.rhs_vec);
         for (k, &i) in mech.dependent.iter().enumerate() {
@@ -834,19 +988,142 @@ impl Kinematics {
         }
     }
 
-    /// The accelerations for q̈ = 0: ẍ0 = F,u ü + (F,ξξ ξ̇)ξ̇ and the matching
-    /// ε̈0, by one solve with −D,xx\[ẋ, ẋ\] (thesis (5.8b)). Call after
-    /// [`velocities`](Self::velocities). Then ẍ = F,q q̈ + ẍ0.
-    pub fn accelerations(&mut self) {
-        let n_u = self.n_u;
-        let mech = self.mech.clone();
-        // c = D,xx[ẋ, ẋ] per element
+    /// ẋ and ε̇ for ξ̇ = (q̇, u̇(t)) without F,ξ: one solve of
+    /// J ẋ_dep = ė_c − D_c,x_ξ ẋ_ξ (the time derivative of the constraint
+    /// equations D_c(x) = (0, q_ε, u_ε), thesis (5.8a)) with the factorization of
+    /// J at hand. After [`solve_chord`](Self::solve_chord) that factorization
+    /// may be of a nearby configuration: the solution is then refined against
+    /// the exact J(x) (iterative refinement), and J is factorized afresh only
+    /// if the refinement does not contract fast. ε̇ is exact on the constraint
+    /// rows and D,x ẋ elsewhere.
+    pub fn velocities_refined(&mut self, qd: &[f64]) -> Result<(), KinematicsError> {
+        let (n_q, n_u) = (self.n_q, self.n_u);
+        self.xid[..n_q].copy_from_slice(qd);
+        for k in 0..n_u {
+            self.xid[n_q + k] = self.mech.inputs[k].function.eval(self.t).1;
+        }
+        let mut rhs = std::mem::take(&mut self.vel_rhs);
+        for (r, j) in self.mech.constraint_rows.iter().enumerate() {
+            rhs[r] = match self.mech.e_roles[*j] {
+                ERole::Dof(k) => self.xid[k],
+                ERole::Input(k) => self.xid[n_q + k],
+                _ => 0.0,
+            };
+        }
+        let xid = &self.xid;
+        self.for_each_nodal_xi_entry(|r, k, d| rhs[r] -= d * xid[k]);
+        let mut v = std::mem::take(&mut self.rhs_vec);
+        let solved = self.solve_refined(&rhs, &mut v);
+        self.vel_rhs = rhs;
+        if let Err(e) = solved {
+            self.rhs_vec = v;
+            return Err(e);
+        }
+        for (i, r) in self.mech.x_roles.iter().enumerate() {
+            self.xd[i] = match r {
+                XRole::Fixed => 0.0,
+                XRole::Dof(k) => self.xid[*k],
+                XRole::Input(k) => self.xid[n_q + k],
+                XRole::Dependent(k) => v[*k],
+            };
+        }
+        self.rhs_vec = v;
+        for (j, r) in self.mech.e_roles.iter().enumerate() {
+            if self.row_of[j].is_some() {
+                self.epsd[j] = match r {
+                    ERole::Dof(k) => self.xid[*k],
+                    ERole::Input(k) => self.xid[n_q + k],
+                    _ => 0.0,
+                };
+            }
+        }
+        for &(ei, a) in &self.free_deformations {
+            let e = &self.mech.elements[ei];
+            let nx = self.maps[ei].nx;
+            let row = &self.jac_local[ei][a * nx..(a + 1) * nx];
+            self.epsd[e.eps_offset + a] = e
+                .x_index
+                .iter()
+                .zip(row)
+                .map(|(gi, d)| d * self.xd[*gi])
+                .sum();
+        }
+        Ok(())
+    }
+
+    /// Solves J(x) v = b at the solved configuration: directly when the
+    /// factorization is of this x, else by iterative refinement with the
+    /// factorization of a nearby configuration (converged when the update is
+    /// below 1e-14 of |v|), falling back to a fresh factorization when the
+    /// updates do not shrink at least fourfold per step.
+    fn solve_refined(&mut self, b: &[f64], v: &mut [f64]) -> Result<(), KinematicsError> {
+        if !self.lu_valid {
+            self.factor_at_x()?;
+        }
+        v.copy_from_slice(b);
+        self.lu.solve_vec(v);
+        if self.lu_at_x {
+            return Ok(());
+        }
+        let mut res = std::mem::take(&mut self.vel_res);
+        let mut prev = f64::INFINITY;
+        let mut converged = false;
+        for _ in 0..MAX_REFINEMENTS {
+            self.refinements += 1;
+            res.copy_from_slice(b);
+            self.sub_jacobian_times(v, &mut res);
+            self.lu.solve_vec(&mut res);
+            let (mut d, mut vmax) = (0.0f64, 0.0f64);
+            for (vi, ri) in v.iter_mut().zip(&res) {
+                *vi += ri;
+                d = d.max(ri.abs());
+                vmax = vmax.max(vi.abs());
+            }
+            if !d.is_finite() {
+                break;
+            }
+            if d <= 1e-14 * vmax {
+                converged = true;
+                break;
+            }
+            if d > 0.25 * prev {
+                break;
+            }
+            prev = d;
+        }
+        self.vel_res = res;
+        if !converged {
+            self.factor_at_x()?;
+            v.copy_from_slice(b);
+            self.lu.solve_vec(v);
+        }
+        Ok(())
+    }
+
+    /// out −= J(x) v, J = ∂D_c/∂x_dep from the element Jacobians at x.
+    fn sub_jacobian_times(&self, v: &[f64], out: &mut [f64]) {
+        for (m, jl) in self.maps.iter().zip(&self.jac_local) {
+            for (a, r) in m.rows.iter().enumerate() {
+                let Some(r) = r else { continue };
+                let row = &jl[a * m.nx..(a + 1) * m.nx];
+                let mut s = 0.0;
+                for (c, col) in m.cols.iter().enumerate() {
+                    if let Some(k) = col {
+                        s += row[c] * v[*k];
+                    }
+                }
+                out[*r] -= s;
+            }
+        }
+    }
+
+    /// The convective terms D,xx\[ẋ, ẋ\] of every deformation at the current
+    /// configuration and velocities (zero for elements at rest), the
+    /// velocity-quadratic part of ε̈ = D,x ẍ + D,xx\[ẋ, ẋ\] (thesis (5.8b)).
+    pub fn convective_terms(&mut self) -> &[f64] {
         let mut xl = [0.0; 64];
         let mut vl = [0.0; 64];
-        let mut c = [0.0; 64];
-        let mut rhs = std::mem::take(&mut self.rhs_vec);
-        rhs.fill(0.0);
-        for (ei, e) in mech.elements.iter().enumerate() {
+        for (ei, e) in self.mech.elements.iter().enumerate() {
             let m = &self.maps[ei];
             if m.ne == 0 {
                 continue;
@@ -857,23 +1134,30 @@ impl Kinematics {
                 vl[k] = self.xd[*gi];
                 moving |= vl[k] != 0.0;
             }
-            let o = e.eps_offset;
-            if !moving {
-                self.epsdd0[o..o + m.ne].fill(0.0);
-                continue;
+            let out = &mut self.dxx_vv[e.eps_offset..e.eps_offset + m.ne];
+            if moving {
+                e.element
+                    .deformation_second_derivative(&xl[..m.nx], &vl[..m.nx], &vl[..m.nx], out);
+            } else {
+                out.fill(0.0);
             }
-            e.element.deformation_second_derivative(
-                &xl[..m.nx],
-                &vl[..m.nx],
-                &vl[..m.nx],
-                &mut c[..m.ne],
-            );
-            for a in 0..m.ne {
-                self.epsdd0[o + a] = c[a];
-                if let Some(r) = m.rows[a] {
-                    rhs[r] -= c[a];
-                }
-            }
+        }
+        &self.dxx_vv
+    }
+
+    /// The accelerations for q̈ = 0: ẍ0 = F,u ü + (F,ξξ ξ̇)ξ̇ and the matching
+    /// ε̈0, by one solve with −D,xx\[ẋ, ẋ\] (thesis (5.8b)). Call after
+    /// [`velocities`](Self::velocities). Then ẍ = F,q q̈ + ẍ0.
+    pub fn accelerations(&mut self) {
+        self.ensure_lu_at_x();
+        let n_u = self.n_u;
+        let mech = self.mech.clone();
+        // c = D,xx[ẋ, ẋ] per element
+        self.convective_terms();
+        self.epsdd0.copy_from_slice(&self.dxx_vv);
+        let mut rhs = std::mem::take(&mut self.rhs_vec);
+        for (r, j) in mech.constraint_rows.iter().enumerate() {
+            rhs[r] = -self.dxx_vv[*j];
         }
         // prescribed input accelerations ü
         let mut udd = vec![0.0; n_u];
@@ -935,6 +1219,7 @@ impl Kinematics {
     /// [`velocities`](Self::velocities)): X1 = ∂ẋ/∂q = (F,qq q̇) (n_x × n_q) and
     /// ∂ε̇/∂q (n_ε × n_q). Column k solves J X1_dep = −D_c,xx\[F,q e_k, ẋ\].
     pub fn velocity_sensitivity(&mut self) -> (Mat<f64>, Mat<f64>) {
+        self.ensure_lu_at_x();
         let mech = self.mech.clone();
         let (n_q, n_x, n_e) = (self.n_q, mech.n_x(), mech.n_eps());
         let n_c = mech.constraint_rows.len();
@@ -966,6 +1251,7 @@ impl Kinematics {
     /// given X1 from [`velocity_sensitivity`](Self::velocity_sensitivity):
     /// J X2_dep = −(D_c,xx\[F e_k, ẍ\] + D_c,xxx\[F e_k, ẋ, ẋ\] + 2 D_c,xx\[X1 e_k, ẋ\]).
     pub fn acceleration_sensitivity(&mut self, xdd: &[f64], x1: &Mat<f64>) -> Mat<f64> {
+        self.ensure_lu_at_x();
         let mech = self.mech.clone();
         let (n_q, n_x) = (self.n_q, mech.n_x());
         let n_c = mech.constraint_rows.len();
@@ -1106,6 +1392,7 @@ impl Kinematics {
     /// G = F,qᵀ (Σ_dep σⱼ Dⱼ,xx − Σ_rows μᵣ Dᵣ,xx) F,q with Jᵀμ = (w + D,xᵀσ_dep)_dep.
     /// Call after [`first_order`](Self::first_order).
     pub fn second_order_contraction(&mut self, w: &[f64], sigma: &[f64]) -> Mat<f64> {
+        self.ensure_lu_at_x();
         let mech = self.mech.clone();
         let n_q = self.n_q;
         let n_c = mech.constraint_rows.len();
