@@ -1,9 +1,17 @@
 //! One evaluation of the equations of motion of the thesis's straight
 //! guidances (44-DOF spatial, 17-DOF planar), and of the static tangent.
+//!
+//! "at one state" repeats the evaluation at a fixed (q, q̇): the position
+//! solve converges at once and the kinematic factorization is of that very
+//! configuration. "along a trajectory" evaluates, in their order, the states
+//! a DOPRI5 run (ode45 tolerances) of the first 2 ms of the response asked
+//! for, so chord Newton steps, a factorization of an earlier configuration
+//! and its refinement, and refactorizations happen as in a simulation.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use flexmb_dynamics::Dynamics;
+use flexmb_dynamics::{integrate_explicit, Dynamics, Integrator, SimulationOptions};
 use flexmb_model::Scene;
+use flexmb_ode::{OdeSystem, RhsError};
 use std::hint::black_box;
 use std::path::Path;
 use std::sync::Arc;
@@ -13,6 +21,48 @@ fn load(name: &str) -> Dynamics {
         .join("../../fixtures/scenes")
         .join(name);
     Dynamics::new(Arc::new(Scene::load(&p).unwrap().build(None).unwrap()))
+}
+
+/// The first-order system of `dy`, recording every state it is evaluated at.
+struct Recorder<'a> {
+    dy: &'a mut Dynamics,
+    states: Vec<(f64, Vec<f64>)>,
+    qdd: Vec<f64>,
+}
+
+impl OdeSystem for Recorder<'_> {
+    fn dim(&self) -> usize {
+        2 * self.dy.n_q()
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RhsError> {
+        let n = self.dy.n_q();
+        self.states.push((t, y.to_vec()));
+        self.dy
+            .accelerations(t, &y[..n], &y[n..], &mut self.qdd)
+            .map_err(|e| RhsError::new(e.to_string()))?;
+        out[..n].copy_from_slice(&y[n..]);
+        out[n..].copy_from_slice(&self.qdd);
+        Ok(())
+    }
+}
+
+/// The states of the first 2 ms of the response from rest at q0.
+fn trajectory(file: &str) -> Vec<(f64, Vec<f64>)> {
+    let mut dy = load(file);
+    let n = dy.n_q();
+    let mut y0 = dy.mechanism().q0();
+    y0.extend(vec![0.0; n]);
+    let mut rec = Recorder {
+        dy: &mut dy,
+        states: vec![],
+        qdd: vec![0.0; n],
+    };
+    let opts = SimulationOptions::new(Integrator::Dopri5, 0.0, 2e-3, 4);
+    integrate_explicit(&mut rec, &opts, 0.0, &y0, |_, _| {
+        flexmb_dynamics::Control::Continue
+    })
+    .unwrap();
+    rec.states
 }
 
 fn eom(c: &mut Criterion) {
@@ -33,12 +83,44 @@ fn eom(c: &mut Criterion) {
         let mut qdd = vec![0.0; n];
         dy.accelerations(0.05, &q, &qd, &mut qdd).unwrap();
         let mut g = c.benchmark_group(name);
-        g.bench_function("equations of motion (q̈ from q, q̇)", |b| {
+        g.bench_function("equations of motion (q̈ from q, q̇) at one state", |b| {
             b.iter(|| {
                 dy.accelerations(0.05, black_box(&q), &qd, &mut qdd)
                     .unwrap()
             })
         });
+        g.bench_function(
+            "equations of motion by the projection (D.10) at one state",
+            |b| {
+                b.iter(|| {
+                    dy.accelerations_by_projection(0.05, black_box(&q), &qd, &mut qdd)
+                        .unwrap()
+                })
+            },
+        );
+        let states = trajectory(file);
+        let mut dy = load(file);
+        let mut k = 0;
+        let (f0, r0) = (
+            dy.kinematics().factorizations(),
+            dy.kinematics().refinements(),
+        );
+        let e0 = dy.evaluations();
+        g.bench_function("equations of motion along a trajectory", |b| {
+            b.iter(|| {
+                let (t, y) = &states[k % states.len()];
+                k += 1;
+                dy.accelerations(*t, black_box(&y[..n]), &y[n..], &mut qdd)
+                    .unwrap()
+            })
+        });
+        let evals = (dy.evaluations() - e0).max(1) as f64;
+        println!(
+            "{name}: {} recorded states; per evaluation along them {:.3} factorizations and {:.2} refinement steps of the kinematic Jacobian",
+            states.len(),
+            (dy.kinematics().factorizations() - f0) as f64 / evals,
+            (dy.kinematics().refinements() - r0) as f64 / evals
+        );
         g.bench_function("static tangent Kq + Gq", |b| {
             b.iter(|| dy.static_tangent(0.05, black_box(&q)).unwrap())
         });

@@ -2,6 +2,7 @@
 //! Mq q̈ = F,qᵀ (f − Mx ẍ0 − h) − E,qᵀ σ, with Mq = F,qᵀ Mx F,q assembled
 //! element by element, and the residual g(q, q̇, q̈, t) of (E.1).
 
+use crate::nodal_eom::NodalEom;
 use crate::DynamicsError;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
@@ -12,7 +13,6 @@ use faer::{Accum, Mat, MatMut, MatRef, Par};
 use flexmb_element::Element;
 use flexmb_kinematics::Kinematics;
 use flexmb_model::{Coordinate, ERole, Load, Mechanism};
-use crate::nodal_eom::NodalEom;
 use flexmb_rotation::EulerParameters;
 use std::sync::Arc;
 
@@ -535,10 +535,7 @@ impl Dynamics {
         self.kin.velocities_refined(qd).map_err(kin_err)?;
         self.kin.convective_terms();
         self.forces_with(t, true, false);
-        let g = self
-            .mech
-            .gravity
-            .map(|g0| g0.map(|v| v * self.load_factor));
+        let g = self.mech.gravity.map(|g0| g0.map(|v| v * self.load_factor));
         Ok(self
             .nodal
             .accelerations(&self.kin, &self.mech, t, &self.f, &self.sigma, g, qdd)

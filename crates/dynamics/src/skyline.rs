@@ -153,7 +153,10 @@ impl Skyline {
     /// Storage position of entry (i, j), i ≥ j inside the profile, for
     /// [`add_at`](Self::add_at).
     pub fn position(&self, i: usize, j: usize) -> usize {
-        assert!(j <= i && j >= self.first[i], "({i}, {j}) is outside the profile");
+        assert!(
+            j <= i && j >= self.first[i],
+            "({i}, {j}) is outside the profile"
+        );
         self.start[i] + j - self.first[i]
     }
 

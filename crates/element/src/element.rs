@@ -912,6 +912,29 @@ impl Element {
         }
     }
 
+    /// TᵀM(x)T for the local coordinates in which the Euler parameters of
+    /// orientation slot k (in slot order) are replaced through
+    /// `bases[k] = Some(P)` (λ̇ = P a with P 4 × 3, e.g. Λᵀ(λ), whose
+    /// columns span the tangent space of the normalization), row-major in
+    /// the reduced coordinates (slot order, three per replaced orientation).
+    /// Returns the order of the result; `None` for elements without
+    /// co-rotational spatial inertia (apply T to
+    /// [`mass_matrix`](Self::mass_matrix) then).
+    pub fn mass_matrix_with_bases(
+        &self,
+        x: &[f64],
+        bases: &[Option<[[f64; 3]; 4]>],
+        out: &mut [f64],
+    ) -> Option<usize> {
+        match &self.kind {
+            Kind::TwoNode {
+                inertia: Some(i), ..
+            }
+            | Kind::RigidBody(i) => Some(i.mass_with_bases(x, bases, out)),
+            _ => None,
+        }
+    }
+
     /// A factor R of the mass matrix, M = RᵀR (row-major m × n_x with
     /// m ≤ n_x), written to `out`; returns m (0 for massless elements). For
     /// co-rotational inertia R = Ū B̂ with the constant M̄ = ŪᵀŪ, so that

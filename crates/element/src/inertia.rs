@@ -410,33 +410,56 @@ impl SpatialInertia {
 
     /// The columns of B̂ = \[B 0; 0 I\] (3.31) at x: each has at most three
     /// non-zeros (a column of the 3×3 frame block, of a 3×4 Λ block, or a unit
-    /// entry for a mode amplitude).
-    fn bhat_columns(&self, x: &[f64]) -> BhatColumns {
-        let nxn = self.nx_nodes();
+    /// entry for a mode amplitude). With `bases[n] = Some(P)` (4 × 3) node n's
+    /// four Euler-parameter columns are replaced by the three of G_n P
+    /// (λ̇ = P a). Returns the columns and their number.
+    fn bhat_columns(&self, x: &[f64], bases: &[Option<[[f64; 3]; 4]>]) -> (BhatColumns, usize) {
         let nv = self.nv();
         let nw = self.mbar.nrows();
         let b = self.blocks(x);
         let mut cols = [[(0usize, 0.0f64); 3]; 14 + MAX_MODES];
         let mut cnt = [0usize; 14 + MAX_MODES];
+        let mut j0 = 0;
         for nd in 0..self.nodes {
             for j in 0..3 {
                 for i in 0..3 {
-                    cols[7 * nd + j][i] = (6 * nd + i, b.ft.0[i][j]);
+                    cols[j0 + j][i] = (6 * nd + i, b.ft.0[i][j]);
                 }
-                cnt[7 * nd + j] = 3;
+                cnt[j0 + j] = 3;
             }
-            for j in 0..4 {
-                for i in 0..3 {
-                    cols[7 * nd + 3 + j][i] = (6 * nd + 3 + i, b.g[nd][i][j]);
+            j0 += 3;
+            let g = &b.g[nd];
+            match bases.get(nd).copied().flatten() {
+                Some(p) => {
+                    for k in 0..3 {
+                        for i in 0..3 {
+                            let v = g[i][0] * p[0][k]
+                                + g[i][1] * p[1][k]
+                                + g[i][2] * p[2][k]
+                                + g[i][3] * p[3][k];
+                            cols[j0 + k][i] = (6 * nd + 3 + i, v);
+                        }
+                        cnt[j0 + k] = 3;
+                    }
+                    j0 += 3;
                 }
-                cnt[7 * nd + 3 + j] = 3;
+                None => {
+                    for j in 0..4 {
+                        for i in 0..3 {
+                            cols[j0 + j][i] = (6 * nd + 3 + i, g[i][j]);
+                        }
+                        cnt[j0 + j] = 3;
+                    }
+                    j0 += 4;
+                }
             }
         }
         for i in nv..nw {
-            cols[nxn + i - nv][0] = (i, 1.0);
-            cnt[nxn + i - nv] = 1;
+            cols[j0][0] = (i, 1.0);
+            cnt[j0] = 1;
+            j0 += 1;
         }
-        (cols, cnt)
+        ((cols, cnt), j0)
     }
 
     /// The mass matrix M = \[B; I\]ᵀ M̄ \[B; I\] (3.31) (row-major, n × n with
@@ -444,11 +467,22 @@ impl SpatialInertia {
     /// non-zeros: first P = M̄ B̂ (nw × n, three products per entry), then the
     /// upper triangle of M = B̂ᵀ P (three products per entry), mirrored.
     pub fn mass(&self, x: &[f64], out: &mut [f64]) {
-        let nxn = self.nx_nodes();
-        let nv = self.nv();
+        self.mass_with_bases(x, &[], out);
+    }
+
+    /// TᵀMT for the coordinates in which node n's Euler parameters are
+    /// replaced through `bases[n] = Some(P)` (λ̇ = P a, P 4 × 3): the same
+    /// products over the columns of B̂T (each still with at most three
+    /// non-zeros), so the transformed matrix costs no more than M. Returns
+    /// its order (7·nodes + modes − one per replaced node).
+    pub fn mass_with_bases(
+        &self,
+        x: &[f64],
+        bases: &[Option<[[f64; 3]; 4]>],
+        out: &mut [f64],
+    ) -> usize {
         let nw = self.mbar.nrows();
-        let n = nxn + nw - nv;
-        let (cols, cnt) = self.bhat_columns(x);
+        let ((cols, cnt), n) = self.bhat_columns(x, bases);
         // P row-major nw × n; a beam's (12 × 14) fits a small array, whose
         // zeroing is a tenth of the one sized for the most modes
         const SMALL: usize = 12 * 14;
@@ -459,6 +493,7 @@ impl SpatialInertia {
             let mut p = [0.0f64; MAX_W * (14 + MAX_MODES)];
             self.mass_from_columns(&cols, &cnt, n, &mut p[..nw * n], out);
         }
+        n
     }
 
     /// M = B̂ᵀ (M̄ B̂) from the columns of B̂, with `p` (zeroed, nw × n) for M̄ B̂.
@@ -811,7 +846,7 @@ mod tests {
     fn mass_reference(si: &SpatialInertia, x: &[f64]) -> Vec<f64> {
         let nw = si.mbar.nrows();
         let n = si.nx_nodes() + nw - si.nv();
-        let (cols, cnt) = si.bhat_columns(x);
+        let ((cols, cnt), _) = si.bhat_columns(x, &[]);
         let mut out = vec![0.0; n * n];
         for i in 0..n {
             for j in 0..n {
@@ -829,6 +864,89 @@ mod tests {
 
     fn max_abs(v: &[f64]) -> f64 {
         v.iter().fold(0.0f64, |m, a| m.max(a.abs()))
+    }
+
+    /// TᵀMT with node-wise 4 × 3 bases of the Euler-parameter rates against
+    /// the explicit congruence of the full mass matrix.
+    #[test]
+    fn mass_with_bases_is_the_congruence_of_the_mass() {
+        for (modes, variant) in [
+            (0, VelocityTransform::B3),
+            (3, VelocityTransform::B1),
+            (0, VelocityTransform::B2),
+        ] {
+            let si = beam_inertia(variant, modes);
+            let i = modes;
+            let x = state(modes);
+            let n = si.nx_nodes() + si.mbar.nrows() - si.nv();
+            let mut m = vec![0.0; n * n];
+            si.mass(&x, &mut m);
+            let pa = [
+                [0.3, -0.1, 0.7],
+                [0.2, 0.9, -0.4],
+                [-0.5, 0.1, 0.2],
+                [0.6, 0.3, 0.1],
+            ];
+            let pb = [
+                [-0.2, 0.4, 0.1],
+                [0.7, -0.3, 0.5],
+                [0.1, 0.2, -0.8],
+                [0.3, 0.6, 0.2],
+            ];
+            for bases in [[Some(pa), None], [Some(pa), Some(pb)], [None, Some(pb)]] {
+                // T: identity except the replaced orientation blocks
+                let mut cols: Vec<Vec<f64>> = vec![];
+                for nd in 0..2 {
+                    for k in 0..3 {
+                        let mut c = vec![0.0; n];
+                        c[7 * nd + k] = 1.0;
+                        cols.push(c);
+                    }
+                    match bases[nd] {
+                        Some(p) => {
+                            for k in 0..3 {
+                                let mut c = vec![0.0; n];
+                                for r in 0..4 {
+                                    c[7 * nd + 3 + r] = p[r][k];
+                                }
+                                cols.push(c);
+                            }
+                        }
+                        None => {
+                            for r in 0..4 {
+                                let mut c = vec![0.0; n];
+                                c[7 * nd + 3 + r] = 1.0;
+                                cols.push(c);
+                            }
+                        }
+                    }
+                }
+                for k in 14..n {
+                    let mut c = vec![0.0; n];
+                    c[k] = 1.0;
+                    cols.push(c);
+                }
+                let nr = cols.len();
+                let mut out = vec![0.0; nr * nr];
+                assert_eq!(si.mass_with_bases(&x, &bases, &mut out), nr);
+                let scale = max_abs(&m);
+                for a in 0..nr {
+                    for b in 0..nr {
+                        let mut v = 0.0;
+                        for r in 0..n {
+                            for c in 0..n {
+                                v += cols[a][r] * m[r * n + c] * cols[b][c];
+                            }
+                        }
+                        assert!(
+                            (out[a * nr + b] - v).abs() <= 1e-13 * scale,
+                            "modes {i}, {bases:?}: ({a}, {b}) {} vs {v}",
+                            out[a * nr + b]
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -276,3 +276,66 @@ fn adjoint_transfer_matches_the_explicit_product() {
         }
     }
 }
+
+/// Along a path of nearby configurations (as an integrator visits them),
+/// the chord solve with the factorization of earlier configurations and the
+/// refined velocities give the configuration and ẋ = F,ξ ξ̇ of a solve that
+/// factorizes J at every point; F,ξ after a chord solve (factorized on
+/// demand) equals F,ξ after a full solve. Deformation and nodal DOFs, dense
+/// and sparse factorizations.
+#[test]
+fn chord_solve_and_refined_velocities_match_the_full_solve() {
+    for dofs in [DofChoice::Deformations, DofChoice::NodalCoordinates] {
+        for sparse in [false, true] {
+            let make = |d: DofChoice| {
+                if sparse {
+                    sparse_kinematics("straight_guidance_spatial.ron", d)
+                } else {
+                    kinematics("straight_guidance_spatial.ron", d)
+                }
+            };
+            let (mut chord, mut full) = (make(dofs.clone()), make(dofs.clone()));
+            let nq = chord.n_q();
+            let mut rng = StdRng::seed_from_u64(11);
+            let start = deflected(&chord, &mut rng, 2e-3);
+            let dir: Vec<f64> = (0..nq).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let qd: Vec<f64> = (0..nq).map(|_| rng.random_range(-0.05..0.05)).collect();
+            let mut refinements_seen = false;
+            for step in 0..40 {
+                // steps from 1e-7 (refinement converges at once) to 1e-3 (refreshes)
+                let h = 1e-7 * 10f64.powf(step as f64 / 10.0);
+                let q: Vec<f64> = start.iter().zip(&dir).map(|(a, d)| a + h * d).collect();
+                chord.solve_chord(&q, 0.0).unwrap();
+                chord.velocities_refined(&qd).unwrap();
+                full.solve(&q, 0.0).unwrap();
+                full.first_order();
+                full.velocities(&qd);
+                let tag = format!("{dofs:?} sparse={sparse} step {step}");
+                let xs = full.x().iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                for (a, b) in chord.x().iter().zip(full.x()) {
+                    assert!((a - b).abs() <= 1e-11 * xs, "{tag}: x {a} vs {b}");
+                }
+                let vs = full.xd().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for (a, b) in chord.xd().iter().zip(full.xd()) {
+                    assert!((a - b).abs() <= 1e-9 * vs, "{tag}: ẋ {a} vs {b}");
+                }
+                for (a, b) in chord.epsd().iter().zip(full.epsd()) {
+                    assert!((a - b).abs() <= 1e-9 * vs.max(1.0), "{tag}: ε̇ {a} vs {b}");
+                }
+                refinements_seen |= chord.refinements() > 0;
+            }
+            assert!(refinements_seen, "the path never exercised the refinement");
+            // F,ξ on demand after a chord solve
+            chord.first_order();
+            let (fc, ff) = (chord.f_xi(), full.f_xi());
+            let fs = (0..ff.ncols())
+                .flat_map(|c| ff.col_as_slice(c).iter().copied().collect::<Vec<_>>())
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            for c in 0..ff.ncols() {
+                for (a, b) in fc.col_as_slice(c).iter().zip(ff.col_as_slice(c)) {
+                    assert!((a - b).abs() <= 1e-9 * fs, "F,ξ {a} vs {b}");
+                }
+            }
+        }
+    }
+}
