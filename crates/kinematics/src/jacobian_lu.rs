@@ -253,7 +253,7 @@ impl JacobianLu {
             b.fill(f64::NAN);
             return;
         }
-        if let Some(d) = &self.dense {
+        if let Some(d) = &mut self.dense {
             d.lu.solve_in_place(b);
             return;
         }
@@ -278,7 +278,7 @@ impl JacobianLu {
             b.fill(f64::NAN);
             return;
         }
-        if let Some(d) = &self.dense {
+        if let Some(d) = &mut self.dense {
             d.lu.solve_transpose_in_place(b);
             return;
         }
