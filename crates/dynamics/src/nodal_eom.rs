@@ -106,11 +106,9 @@ pub(crate) struct NodalEom {
     /// Per element: the lower pairs of its unknowns as (l1 · n_l + l2,
     /// profile position).
     pairs: Vec<Vec<(usize, usize)>>,
-    /// Per element with co-rotational spatial inertia: the eliminated
-    /// orientation of each orientation slot, and the lower pairs of its
-    /// unknowns as (position in `Element::mass_matrix_with_bases`'s result,
-    /// profile position); `None`: T_eᵀ M_e T_e by `transform_mass`.
-    reduced_mass: Vec<Option<(Vec<Option<usize>>, Vec<(usize, usize)>)>>,
+    /// Per element with co-rotational spatial inertia, how its mass enters
+    /// in the reduced coordinates; `None`: T_eᵀ M_e T_e by `transform_mass`.
+    reduced_mass: Vec<Option<ReducedMass>>,
     /// Constraint rows as (element, local deformation, global deformation),
     /// sorted by their first unknown.
     rows: Vec<(usize, usize, usize)>,
@@ -148,19 +146,26 @@ pub(crate) struct NodalEom {
     pub augmented: bool,
 }
 
-/// The layout of `Element::mass_matrix_with_bases` for element `e`, if it
-/// has co-rotational spatial inertia (at most two orientation slots): for
-/// each orientation slot the eliminated orientation whose four Euler
-/// parameters it holds in order (`None`: kept as four coordinates), and the
-/// lower pairs of the element's unknowns as (position in the row-major
-/// reduced matrix, profile position).
+/// An element's mass matrix in the coordinates with eliminated orientations,
+/// as `Element::mass_matrix_with_bases` returns it.
+struct ReducedMass {
+    /// The eliminated orientation held by each orientation slot (`None`:
+    /// kept as four coordinates).
+    orient: Vec<Option<usize>>,
+    /// The lower pairs of the element's unknowns as (position in the
+    /// row-major reduced matrix, profile position).
+    pairs: Vec<(usize, usize)>,
+}
+
+/// The reduced-mass layout of element `e`, if it has co-rotational spatial
+/// inertia (at most two orientation slots).
 fn reduced_mass_layout(
     e: &flexmb_model::MechElement,
     x0: &[f64],
     unknown: &[Unknown],
     orientations: &[Orientation],
     mass: &Skyline,
-) -> Option<(Vec<Option<usize>>, Vec<(usize, usize)>)> {
+) -> Option<ReducedMass> {
     use flexmb_element::Slot;
     let n_orient = e
         .element
@@ -223,7 +228,7 @@ fn reduced_mass_layout(
             }
         }
     }
-    Some((orient, pairs))
+    Some(ReducedMass { orient, pairs })
 }
 
 impl NodalEom {
@@ -455,7 +460,8 @@ impl NodalEom {
     }
 
     /// Unknowns, stored entries of the profile of the mass matrix and
-    /// constraint rows (for reports).
+    /// constraint rows.
+    #[cfg(test)]
     pub fn size(&self) -> (usize, usize, usize) {
         (self.mass.n(), self.mass.nnz(), self.rows.len())
     }
@@ -550,14 +556,14 @@ impl NodalEom {
             for (k, gi) in e.x_index.iter().enumerate() {
                 self.fx[*gi] -= fl[k];
             }
-            if let Some((orient, mass_pairs)) = &self.reduced_mass[ei] {
+            if let Some(rm) = &self.reduced_mass[ei] {
                 let mut bases = [None; 2];
-                for (b, o) in bases.iter_mut().zip(orient) {
+                for (b, o) in bases.iter_mut().zip(&rm.orient) {
                     *b = o.map(|o| self.basis[o].0);
                 }
                 e.element
-                    .mass_matrix_with_bases(&xl[..n], &bases[..orient.len()], &mut self.me);
-                for &(m, p) in mass_pairs {
+                    .mass_matrix_with_bases(&xl[..n], &bases[..rm.orient.len()], &mut self.me);
+                for &(m, p) in &rm.pairs {
                     self.mass.add_at(p, self.me[m]);
                 }
             } else {

@@ -134,6 +134,7 @@ impl Skyline {
     }
 
     /// Stored entries.
+    #[cfg(test)]
     pub fn nnz(&self) -> usize {
         self.values.len()
     }
@@ -144,7 +145,7 @@ impl Skyline {
     }
 
     /// A(i, j) += v for i ≥ j inside the profile.
-    #[inline]
+    #[cfg(test)]
     pub fn add_lower(&mut self, i: usize, j: usize, v: f64) {
         let p = self.position(i, j);
         self.values[p] += v;
@@ -202,7 +203,8 @@ impl Skyline {
             }
             let off = &row_i[..i - fi];
             let d = row_i[i - fi] - dot(off, off);
-            if !(d > 1e-13 * self.diag[i].abs()) || !d.is_finite() {
+            let positive = d.is_finite() && d > 1e-13 * self.diag[i].abs();
+            if !positive {
                 return Err(NotPositiveDefinite { row: i });
             }
             row_i[i - fi] = d.sqrt();

@@ -329,7 +329,7 @@ fn chord_solve_and_refined_velocities_match_the_full_solve() {
             chord.first_order();
             let (fc, ff) = (chord.f_xi(), full.f_xi());
             let fs = (0..ff.ncols())
-                .flat_map(|c| ff.col_as_slice(c).iter().copied().collect::<Vec<_>>())
+                .flat_map(|c| ff.col_as_slice(c).to_vec())
                 .fold(0.0f64, |m, v| m.max(v.abs()));
             for c in 0..ff.ncols() {
                 for (a, b) in fc.col_as_slice(c).iter().zip(ff.col_as_slice(c)) {
