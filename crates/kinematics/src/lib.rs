@@ -177,6 +177,8 @@ pub struct Kinematics {
     factorizations: u64,
     /// Iterative-refinement steps of velocity solves so far.
     refinements: u64,
+    /// Solves that needed continuation from the last solution.
+    continuations: u64,
     dx: Vec<f64>,
     rhs_vec: Vec<f64>,
     last_update: Vec<f64>,
@@ -322,6 +324,7 @@ impl Kinematics {
             lu_at_x: false,
             factorizations: 0,
             refinements: 0,
+            continuations: 0,
             dx: vec![0.0; n_c],
             rhs_vec: vec![0.0; n_c],
             last_update: vec![0.0; n_c],
@@ -418,6 +421,12 @@ impl Kinematics {
     /// so far (each one product with J and one solve).
     pub fn refinements(&self) -> u64 {
         self.refinements
+    }
+
+    /// Solves so far whose first Newton solve failed and that continued from
+    /// the last solution in equal steps of ξ.
+    pub fn continuations(&self) -> u64 {
+        self.continuations
     }
 
     fn eval_elements(&mut self, with_jac: bool) {
@@ -543,20 +552,25 @@ impl Kinematics {
                 self.x_good.copy_from_slice(&self.x);
                 self.xi_good.copy_from_slice(&self.xi);
             }
-            Err(_) => {
-                self.lu_valid = false;
-                self.lu_at_x = false;
-                // back to the last converged configuration: the next solve
-                // (e.g. a retried, smaller step) starts from a good guess
-                self.x.copy_from_slice(&self.x_good);
-                self.xi.copy_from_slice(&self.xi_good);
-                self.have_solution = true;
-                self.first_order_valid = false;
-                // deformations and element Jacobians of that configuration
-                self.eval_elements(true);
-            }
+            // back to the last converged configuration: the next solve
+            // (e.g. a retried, smaller step) starts from a good guess
+            Err(_) => self.restore_last_solution(),
         }
         r
+    }
+
+    /// Returns to the last converged configuration after a failed solve: x
+    /// and ξ, the deformations and element Jacobians there, and no
+    /// factorization (the last one may be of a configuration far off, and
+    /// must neither pass for one at x nor predict from it).
+    fn restore_last_solution(&mut self) {
+        self.x.copy_from_slice(&self.x_good);
+        self.xi.copy_from_slice(&self.xi_good);
+        self.have_solution = true;
+        self.first_order_valid = false;
+        self.lu_valid = false;
+        self.lu_at_x = false;
+        self.eval_elements(true);
     }
 
     fn solve_inner(&mut self, q: &[f64], t: f64, mode: Refactor) -> Result<(), KinematicsError> {
@@ -579,13 +593,11 @@ impl Kinematics {
         // continuation from the last converged configuration: reach the target
         // in 2, 4, …, 64 equal steps of ξ (large jumps, e.g. a first solve far
         // from the reference configuration)
+        self.continuations += 1;
         let start = self.xi_good.clone();
         let mut err = first;
         for n in [2usize, 4, 8, 16, 32, 64] {
-            self.x.copy_from_slice(&self.x_good);
-            self.xi.copy_from_slice(&self.xi_good);
-            self.have_solution = true;
-            self.first_order_valid = false;
+            self.restore_last_solution();
             let mut ok = true;
             for j in 1..=n {
                 let s = j as f64 / n as f64;

@@ -238,6 +238,39 @@ mod tests {
         }
     }
 
+    /// Pseudo-random matrices up to the size of the guidance's Jacobian with
+    /// small diagonals, so that partial pivoting exchanges many rows.
+    #[test]
+    fn random_matrices_with_heavy_pivoting() {
+        let mut state = 17u64;
+        let mut rnd = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let mut lu = DenseLu::default();
+        for n in [2usize, 8, 31, 77, 80] {
+            let a = Mat::from_fn(n, n, |i, j| if i == j { 1e-3 * rnd() } else { rnd() });
+            assert!(lu.factor(a.as_ref()));
+            let b: Vec<f64> = (0..n).map(|_| rnd()).collect();
+            let mut x = b.clone();
+            lu.solve_vec(&mut x, &mut Mat::zeros(n, 1));
+            let mut xt = b.clone();
+            lu.solve_transpose_vec(&mut xt, &mut Mat::zeros(n, 1));
+            let scale = x.iter().chain(&xt).fold(1.0f64, |m, v| m.max(v.abs()));
+            for i in 0..n {
+                let r: f64 = (0..n).map(|j| a[(i, j)] * x[j]).sum::<f64>() - b[i];
+                let rt: f64 = (0..n).map(|j| a[(j, i)] * xt[j]).sum::<f64>() - b[i];
+                assert!(r.abs() <= 1e-10 * scale, "n = {n}: residual {r}");
+                assert!(
+                    rt.abs() <= 1e-10 * scale,
+                    "n = {n}: transposed residual {rt}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn singular_and_non_finite_matrices_are_refused_and_solve_to_nan() {
         let mut lu = DenseLu::default();

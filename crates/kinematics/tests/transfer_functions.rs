@@ -339,3 +339,61 @@ fn chord_solve_and_refined_velocities_match_the_full_solve() {
         }
     }
 }
+
+/// A jump the first Newton solve cannot make (it falls back to continuation
+/// from the last solution, restored with its own deformations and element
+/// Jacobians) ends with the configuration and F,ξ of a path of small steps,
+/// whether the chord or the full solve made it, and chord velocities right
+/// after it are exact.
+#[test]
+fn a_far_jump_by_continuation_gives_the_configuration_and_derivatives_of_small_steps() {
+    let mut rng = StdRng::seed_from_u64(5);
+    let reference_k = kinematics("straight_guidance_spatial.ron", DofChoice::Deformations);
+    let nq = reference_k.n_q();
+    let far = deflected(&reference_k, &mut rng, 4e-3);
+    let qd: Vec<f64> = (0..nq).map(|_| rng.random_range(-0.05..0.05)).collect();
+    let mut reference = reference_k;
+    for j in 1..=40 {
+        let q: Vec<f64> = far.iter().map(|v| v * j as f64 / 40.0).collect();
+        reference.solve(&q, 0.0).unwrap();
+        reference.first_order();
+    }
+    reference.velocities(&qd);
+    for chord in [false, true] {
+        // the iterations the jump takes at once, less one: the solve then
+        // continues from the last solution in smaller steps
+        let mut once = kinematics("straight_guidance_spatial.ron", DofChoice::Deformations);
+        once.solve(&vec![0.0; nq], 0.0).unwrap();
+        once.solve(&far, 0.0).unwrap();
+        let mut k = kinematics("straight_guidance_spatial.ron", DofChoice::Deformations);
+        k.solve(&vec![0.0; nq], 0.0).unwrap();
+        k.set_newton_options(NewtonOptions {
+            tol: 1e-12,
+            max_iterations: once.iterations() - 1,
+        });
+        if chord {
+            k.solve_chord(&far, 0.0).unwrap();
+            k.velocities_refined(&qd).unwrap();
+        } else {
+            k.solve(&far, 0.0).unwrap();
+            k.first_order();
+            k.velocities(&qd);
+        }
+        assert_eq!(k.continuations(), 1, "the jump is made by continuation");
+        let xs = reference.x().iter().fold(1.0f64, |m, v| m.max(v.abs()));
+        for (a, b) in k.x().iter().zip(reference.x()) {
+            assert!((a - b).abs() <= 1e-10 * xs, "chord {chord}: x {a} vs {b}");
+        }
+        let vs = reference.xd().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (a, b) in k.xd().iter().zip(reference.xd()) {
+            assert!((a - b).abs() <= 1e-8 * vs, "chord {chord}: ẋ {a} vs {b}");
+        }
+        k.first_order();
+        let (f, fr) = (k.f_xi(), reference.f_xi());
+        for c in 0..fr.ncols() {
+            for (a, b) in f.col_as_slice(c).iter().zip(fr.col_as_slice(c)) {
+                assert!((a - b).abs() <= 1e-8 * xs, "chord {chord}: F,ξ {a} vs {b}");
+            }
+        }
+    }
+}
