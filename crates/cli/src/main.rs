@@ -344,7 +344,7 @@ fn simulate(a: &SimulateArgs, interrupted: &Arc<AtomicBool>) -> Result<(), Failu
     };
     pb.finish_and_clear();
     let (response, model) = result?;
-    println!("{}", response.summary());
+    println!("{}", report::summary(&response));
     let mut comments = vec![format!("flexmb simulate {}", a.scene.display())];
     if let (Some(m), Some(d)) = (&a.reduced, &model) {
         comments.push(format!("reduced model {}: {d}", m.display()));
@@ -378,17 +378,8 @@ fn simulate_unreduced(
     let qd0 = dy
         .initial_qd(0.0, &q0)
         .map_err(|e| Failure::Compute(e.to_string()))?;
-    let traj = dy
-        .simulate(0.0, &q0, &qd0, opts, |t, _, _| observer(t))
-        .map_err(|e| Failure::Compute(e.to_string()))?;
-    Ok(Response {
-        t: traj.t,
-        q: traj.q,
-        qd: traj.qd,
-        stats: traj.stats,
-        wall_time: traj.wall_time,
-        stopped: traj.stopped,
-    })
+    dy.simulate(0.0, &q0, &qd0, opts, |t, _, _| observer(t))
+        .map_err(|e| Failure::Compute(e.to_string()))
 }
 
 fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), Failure> {

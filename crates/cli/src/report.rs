@@ -3,7 +3,7 @@
 //! sweep (`eigenfrequencies.csv`/`.svg`) and progress bars.
 
 use crate::{io_err, Failure};
-use flexmb_dynamics::{Dynamics, OutputTable, Stats};
+use flexmb_dynamics::{Dynamics, OutputTable};
 use flexmb_plot::{write_csv, Plot, Series};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::Path;
@@ -45,35 +45,20 @@ pub(crate) fn time_bar() -> ProgressBar {
 }
 
 /// A time response in the unreduced coordinates (a reduced one mapped by
-/// q = G(z), q̇ = G,z ż) and what it cost.
-pub(crate) struct Response {
-    /// Output times.
-    pub t: Vec<f64>,
-    /// q at each output time.
-    pub q: Vec<Vec<f64>>,
-    /// q̇ at each output time.
-    pub qd: Vec<Vec<f64>>,
-    /// The integrator's statistics.
-    pub stats: Stats,
-    /// Wall time of the integration (s).
-    pub wall_time: f64,
-    /// Stopped early (Ctrl-C).
-    pub stopped: bool,
-}
+/// q = G(z), q̇ = G,z ż) and what it cost: the dynamics' trajectory.
+pub(crate) use flexmb_dynamics::Trajectory as Response;
 
-impl Response {
-    /// The line `flexmb simulate` prints: outputs, evaluations, steps, time.
-    pub(crate) fn summary(&self) -> String {
-        format!(
-            "{} outputs to t = {:.4} s: {} function evaluations, {} steps ({} rejected), {:.2} s wall time",
-            self.t.len(),
-            self.t.last().copied().unwrap_or(0.0),
-            self.stats.rhs_evals,
-            self.stats.steps_accepted,
-            self.stats.steps_rejected,
-            self.wall_time
-        )
-    }
+/// The line `flexmb simulate` prints: outputs, evaluations, steps, time.
+pub(crate) fn summary(r: &Response) -> String {
+    format!(
+        "{} outputs to t = {:.4} s: {} function evaluations, {} steps ({} rejected), {:.2} s wall time",
+        r.t.len(),
+        r.t.last().copied().unwrap_or(0.0),
+        r.stats.rhs_evals,
+        r.stats.steps_accepted,
+        r.stats.steps_rejected,
+        r.wall_time
+    )
 }
 
 /// Writes `out/outputs.csv` (the scene's outputs, or the DOFs, at each output
