@@ -177,6 +177,8 @@ pub struct Kinematics {
     factorizations: u64,
     /// Iterative-refinement steps of velocity solves so far.
     refinements: u64,
+    /// Refinement steps beyond the first since the last factorization.
+    extra_refinements: usize,
     /// Solves that needed continuation from the last solution.
     continuations: u64,
     dx: Vec<f64>,
@@ -206,13 +208,21 @@ enum Refactor {
 /// of the spatial guidance against about 12 µs for a factorization.
 const MAX_REFINEMENTS: usize = 3;
 
-/// Refinement steps after which J is factorized afresh at x for the next
-/// solves, although the refinement converged. Measured along a DOPRI5 run
-/// of the spatial guidance (`cargo bench -p flexmb-dynamics --bench eom`):
-/// never refreshing left one factorization for 3619 evaluations and 2.3
-/// steps per evaluation; refreshing after two steps gives 0.15
-/// factorizations and 1.15 steps per evaluation, and 14 % less time.
-const REFRESH_AFTER: usize = 2;
+/// Relative accuracy of a refined velocity solve (the error left in ẋ), at
+/// the level of a direct solve's rounding. 1e-12 saved refinement steps but
+/// measured no faster over a response from equilibrium.
+const REFINED_TOL: f64 = 1e-14;
+
+/// Refinement steps beyond the first, summed since the last factorization,
+/// after which J is factorized afresh at x for the next solves although the
+/// refinement converged: a factorization then costs about what the extra
+/// steps did (ski-rental rule). Measured on the spatial guidance: along the
+/// first 2 ms from rest (`cargo bench -p flexmb-dynamics --bench eom`) a
+/// refresh after every two-step solve beat never refreshing by 14 %, while
+/// over 0.05 s of the response from equilibrium it factorized at 43 % of
+/// the evaluations and was 10–15 % slower than this budget of six, which
+/// factorizes at 15 % of them (the machine's noise is ±10 %).
+const REFRESH_BUDGET: usize = 6;
 
 /// Marks a local Jacobian entry that is not part of J.
 const NO_ENTRY: usize = usize::MAX;
@@ -324,6 +334,7 @@ impl Kinematics {
             lu_at_x: false,
             factorizations: 0,
             refinements: 0,
+            extra_refinements: 0,
             continuations: 0,
             dx: vec![0.0; n_c],
             rhs_vec: vec![0.0; n_c],
@@ -764,6 +775,7 @@ impl Kinematics {
     fn factor_at_x(&mut self) -> Result<(), KinematicsError> {
         self.assemble_jacobian();
         self.factorizations += 1;
+        self.extra_refinements = 0;
         if !self.lu.factor() {
             self.lu_valid = false;
             self.lu_at_x = false;
@@ -1112,7 +1124,9 @@ impl Kinematics {
             // with the observed contraction ρ = d/d_prev the error left after
             // this update is about d ρ/(1 − ρ)
             let rho = if prev > 0.0 { d / prev } else { 0.0 };
-            if d <= 1e-14 * vmax || (rho < 0.25 && d * rho / (1.0 - rho) <= 1e-14 * vmax) {
+            if d <= REFINED_TOL * vmax
+                || (rho < 0.25 && d * rho / (1.0 - rho) <= REFINED_TOL * vmax)
+            {
                 converged = true;
                 break;
             }
@@ -1126,10 +1140,13 @@ impl Kinematics {
             self.factor_at_x()?;
             v.copy_from_slice(b);
             self.lu.solve_vec(v);
-        } else if steps >= REFRESH_AFTER {
-            // converged, but the factorization has aged: a fresh one here
-            // serves the next evaluations (the result stays the refined one)
-            self.factor_at_x()?;
+        } else {
+            self.extra_refinements += steps - 1;
+            if self.extra_refinements >= REFRESH_BUDGET {
+                // converged, but the factorization has aged: a fresh one here
+                // serves the next evaluations (the result stays the refined one)
+                self.factor_at_x()?;
+            }
         }
         Ok(())
     }
