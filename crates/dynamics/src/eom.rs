@@ -436,16 +436,12 @@ impl Dynamics {
                 continue;
             }
             let n = e.x_index.len();
-            for (k, gi) in e.x_index.iter().enumerate() {
-                xl[k] = x[*gi];
-                vl[k] = xd[*gi];
-                al[k] = xdd0[*gi];
-            }
+            e.gather(x, &mut xl[..n]);
+            e.gather(xd, &mut vl[..n]);
+            e.gather(xdd0, &mut al[..n]);
             e.element
                 .inertia_force(&xl[..n], &vl[..n], &al[..n], &mut fl[..n]);
-            for (k, gi) in e.x_index.iter().enumerate() {
-                self.w[*gi] -= fl[k];
-            }
+            e.scatter_add(&fl[..n], -1.0, &mut self.w);
             if mass {
                 asm.add_element(ei, &e.element, &xl[..n], fq, n_q, &mut self.mq);
             }

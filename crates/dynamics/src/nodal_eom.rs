@@ -546,16 +546,14 @@ impl NodalEom {
                 continue;
             }
             let n = e.x_index.len();
+            e.gather(x, &mut xl[..n]);
+            e.gather(xd, &mut vl[..n]);
             for (k, gi) in e.x_index.iter().enumerate() {
-                xl[k] = x[*gi];
-                vl[k] = xd[*gi];
                 al[k] = self.xdd[*gi] - self.gravity_axis[*gi].zip(g).map_or(0.0, |(a, g)| g[a]);
             }
             e.element
                 .inertia_force(&xl[..n], &vl[..n], &al[..n], &mut fl[..n]);
-            for (k, gi) in e.x_index.iter().enumerate() {
-                self.fx[*gi] -= fl[k];
-            }
+            e.scatter_add(&fl[..n], -1.0, &mut self.fx);
             if let Some(rm) = &self.reduced_mass[ei] {
                 let mut bases = [None; 2];
                 for (b, o) in bases.iter_mut().zip(&rm.orient) {

@@ -98,50 +98,52 @@ impl DenseLu {
         self.factored
     }
 
-    /// Solves A X = B in place (NaN without a successful factorization).
-    pub fn solve_in_place(&mut self, mut b: MatMut<'_, f64>) {
-        let n = b.nrows();
-        if n == 0 || b.ncols() == 0 {
-            return;
+    /// False (and B set to NaN) when there is nothing to solve with.
+    fn ready(&self, mut b: MatMut<'_, f64>) -> bool {
+        if b.nrows() == 0 || b.ncols() == 0 {
+            return false;
         }
         if !self.factored {
             b.fill(f64::NAN);
-            return;
         }
+        self.factored
+    }
+
+    /// B ← P B (`forward`) or B ← Pᵀ B, column by column.
+    fn permute_rows(&mut self, mut b: MatMut<'_, f64>, forward: bool) {
         let col = &mut self.col;
         for j in 0..b.ncols() {
-            for i in 0..n {
-                col[i] = b[(self.fwd[i], j)];
+            for (i, &p) in self.fwd.iter().enumerate() {
+                if forward {
+                    col[i] = b[(p, j)];
+                } else {
+                    col[p] = b[(i, j)];
+                }
             }
-            for i in 0..n {
-                b[(i, j)] = col[i];
+            for (i, c) in col.iter().enumerate() {
+                b[(i, j)] = *c;
             }
         }
+    }
+
+    /// Solves A X = B in place (NaN without a successful factorization).
+    pub fn solve_in_place(&mut self, mut b: MatMut<'_, f64>) {
+        if !self.ready(b.as_mut()) {
+            return;
+        }
+        self.permute_rows(b.as_mut(), true);
         tri::solve_unit_lower_triangular_in_place(self.lu.as_ref(), b.as_mut(), Par::Seq);
         tri::solve_upper_triangular_in_place(self.lu.as_ref(), b, Par::Seq);
     }
 
     /// Solves Aᵀ X = B in place: Aᵀ = Uᵀ Lᵀ P.
     pub fn solve_transpose_in_place(&mut self, mut b: MatMut<'_, f64>) {
-        let n = b.nrows();
-        if n == 0 || b.ncols() == 0 {
-            return;
-        }
-        if !self.factored {
-            b.fill(f64::NAN);
+        if !self.ready(b.as_mut()) {
             return;
         }
         tri::solve_lower_triangular_in_place(self.lu.transpose(), b.as_mut(), Par::Seq);
         tri::solve_unit_upper_triangular_in_place(self.lu.transpose(), b.as_mut(), Par::Seq);
-        let col = &mut self.col;
-        for j in 0..b.ncols() {
-            for i in 0..n {
-                col[self.fwd[i]] = b[(i, j)];
-            }
-            for i in 0..n {
-                b[(i, j)] = col[i];
-            }
-        }
+        self.permute_rows(b, false);
     }
 
     /// Solves A x = b for a vector, by columns of the factors (each update

@@ -55,6 +55,23 @@ pub struct MechElement {
     pub eps_offset: usize,
 }
 
+impl MechElement {
+    /// Copies the element's coordinates out of `global` (one entry per nodal
+    /// coordinate) into `local` (the element's order).
+    pub fn gather(&self, global: &[f64], local: &mut [f64]) {
+        for (l, i) in local.iter_mut().zip(&self.x_index) {
+            *l = global[*i];
+        }
+    }
+
+    /// Adds `s · local` (the element's order) to `global`.
+    pub fn scatter_add(&self, local: &[f64], s: f64, global: &mut [f64]) {
+        for (l, i) in local.iter().zip(&self.x_index) {
+            global[*i] += s * l;
+        }
+    }
+}
+
 /// A node with the global indices of its coordinates.
 #[derive(Clone, Debug)]
 pub struct NodeInfo {
