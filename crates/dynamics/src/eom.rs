@@ -783,15 +783,8 @@ impl Dynamics {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fixture;
     use flexmb_model::Scene;
-    use std::path::Path;
-
-    fn fixture(name: &str) -> Scene {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../fixtures/scenes")
-            .join(name);
-        Scene::load(&p).unwrap()
-    }
 
     /// A spatial mechanism with every kind of spatial inertia: beams (one with
     /// B1, one with B2), a truss with mass, a point mass and a rigid body with

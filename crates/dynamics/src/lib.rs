@@ -42,6 +42,15 @@ mod simulate;
 mod skyline;
 mod statics;
 
+/// A scene of `fixtures/scenes`, for the unit tests.
+#[cfg(test)]
+pub(crate) fn fixture(name: &str) -> flexmb_model::Scene {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes")
+        .join(name);
+    flexmb_model::Scene::load(&p).unwrap()
+}
+
 pub use eom::{Dynamics, Energies};
 pub use flexmb_ode::{Control, Stats};
 pub use linearize::Linearization;

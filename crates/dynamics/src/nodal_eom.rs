@@ -776,17 +776,9 @@ impl NodalEom {
 
 #[cfg(test)]
 mod tests {
-    use crate::Dynamics;
+    use crate::{fixture, Dynamics};
     use flexmb_model::Scene;
-    use std::path::Path;
     use std::sync::Arc;
-
-    fn fixture(name: &str) -> Scene {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../fixtures/scenes")
-            .join(name);
-        Scene::load(&p).unwrap()
-    }
 
     /// q̈ by the nodal solve and by the projection (D.10) at a perturbed,
     /// moving state; returns the largest difference relative to max |q̈|.
