@@ -40,7 +40,14 @@ struct Run {
 fn sim(model: &Model, label: &str, opts: &SimulationOptions, pg: &Progress) -> Result<Run, String> {
     let t_end = *opts.output_times.last().unwrap_or(&1.0);
     let bar = pg.bar(&format!("simulate {label}"), 1000);
-    let r = simulate(model, opts, NODE, &|t| bar.set((1000.0 * t / t_end) as u64));
+    // errors name the run (e.g. "Unreduced (generalized-α)"), not only the model
+    let named = Model {
+        name: label.into(),
+        ..model.clone()
+    };
+    let r = simulate(&named, opts, NODE, &|t| {
+        bar.set((1000.0 * t / t_end) as u64)
+    });
     bar.finish();
     Ok(Run {
         name: label.into(),
