@@ -2,7 +2,9 @@
 //! equilibrium under gravity, time response to the force pulse), the two-link
 //! manipulator, energy conservation, and element reversal.
 
-use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions, StaticOptions};
+use flexmb_dynamics::{
+    Control, Dynamics, Integrator, SimulationOptions, StaticOptions, StaticSolution,
+};
 use flexmb_kinematics::Kinematics;
 use flexmb_model::{Mechanism, Scene};
 use std::path::Path;
@@ -59,17 +61,24 @@ fn planar_straight_guidance_reaches_the_thesis_deflection() {
     );
 }
 
+/// The spatial straight guidance (thesis §6.4.1), its dynamics and its
+/// static equilibrium under gravity.
+fn spatial_guidance_at_equilibrium() -> (Arc<Mechanism>, Dynamics, StaticSolution) {
+    let mech = Arc::new(scene("straight_guidance_spatial.ron").build(None).unwrap());
+    let mut dy = Dynamics::new(mech.clone());
+    let st = dy
+        .static_equilibrium(0.0, &mech.q0(), &StaticOptions::default())
+        .unwrap();
+    (mech, dy, st)
+}
+
 #[test]
 fn spatial_straight_guidance_statics_under_gravity_and_response() {
     // thesis §6.4.1: equilibrium under gravity first, then the response to the
     // force pulse (6.27); maximal x-deflection 0.0834 m. Integrated with
     // generalized-α (the unreduced model is stiff: 193 kHz).
-    let mech = Arc::new(scene("straight_guidance_spatial.ron").build(None).unwrap());
-    let mut dy = Dynamics::new(mech.clone());
+    let (mech, mut dy, st) = spatial_guidance_at_equilibrium();
     let q0 = mech.q0();
-    let st = dy
-        .static_equilibrium(0.0, &q0, &StaticOptions::default())
-        .unwrap();
     // the gravity sag of the body: small and downwards
     let zs = node_coordinate_history(&mech, &[0.0], std::slice::from_ref(&st.q), "S", 2)[0];
     assert!(zs < 0.0 && zs > -1e-3, "static z of S under gravity: {zs}");
@@ -103,12 +112,8 @@ fn spatial_straight_guidance_statics_under_gravity_and_response() {
 /// the response.
 #[test]
 fn generalized_alpha_at_loose_tolerances_stays_stable_on_the_spatial_guidance() {
-    let mech = Arc::new(scene("straight_guidance_spatial.ron").build(None).unwrap());
-    let mut dy = Dynamics::new(mech.clone());
+    let (mech, mut dy, st) = spatial_guidance_at_equilibrium();
     let q0 = mech.q0();
-    let st = dy
-        .static_equilibrium(0.0, &q0, &StaticOptions::default())
-        .unwrap();
     let opts = SimulationOptions::new(Integrator::GeneralizedAlpha, 0.0, 0.3, 61);
     assert_eq!((opts.rtol, opts.atol), (1e-3, 1e-6));
     let mut max_qd = 0.0f64;
