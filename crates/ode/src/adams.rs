@@ -68,7 +68,7 @@
 
 use crate::common::{
     check_interval, check_optional_positive, check_positive, check_state, check_vector, eval_rhs,
-    Control, FirstOrderSink, Output, Solution, Stats, Tolerance,
+    Control, FirstOrderSink, Output, Solution, Stats, Status, Tolerance,
 };
 use crate::error::OdeError;
 use crate::system::OdeSystem;
@@ -766,6 +766,10 @@ impl Adams {
             stats.record_accepted(if done { x - x_old } else { h });
             let control = sink.step(x, &y, done, |tau, out| st.interpolate(x, &y, tau, out));
             if done || control == Control::Stop {
+                break;
+            }
+            if sys.step_accepted(x, &y) == Control::Stop {
+                sink.solution.status = Status::Stopped { t: x };
                 break;
             }
         }

@@ -52,7 +52,7 @@
 
 use crate::common::{
     check_interval, check_optional_positive, check_positive, check_state, check_vector, eval_rhs,
-    spacing, Control, FirstOrderSink, Output, Solution, Stats, Tolerance,
+    spacing, Control, FirstOrderSink, Output, Solution, Stats, Status, Tolerance,
 };
 use crate::error::OdeError;
 use crate::system::OdeSystem;
@@ -387,6 +387,10 @@ impl Dopri5 {
                 break;
             }
             if control == Control::Stop {
+                return Ok(finish(sink.solution, stats));
+            }
+            if sys.step_accepted(t_new, &w.y_new) == Control::Stop {
+                sink.solution.status = Status::Stopped { t: t_new };
                 return Ok(finish(sink.solution, stats));
             }
             if no_failure && o.fixed_step.is_none() {

@@ -668,6 +668,10 @@ impl GeneralizedAlpha {
             if done || control == Control::Stop {
                 break;
             }
+            if sys.step_accepted(t, &x0.q, &x0.qd) == Control::Stop {
+                sink.solution.status = Status::Stopped { t };
+                break;
+            }
             if o.fixed_step.is_none() {
                 let mut factor = if err > 0.0 {
                     (0.9 * err.powf(-pow)).clamp(0.2, 5.0)

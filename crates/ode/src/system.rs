@@ -3,6 +3,7 @@
 
 use faer::Mat;
 
+use crate::common::Control;
 use crate::error::RhsError;
 use crate::lu::DenseLu;
 
@@ -20,6 +21,16 @@ pub trait OdeSystem {
     /// [`OdeError::Rhs`](crate::OdeError::Rhs). Non-finite values written to
     /// `dy` are detected by the integrator.
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError>;
+
+    /// Called after every accepted step with the new state `(t, y)`, once
+    /// the output points of that step have been emitted. Returning
+    /// [`Control::Stop`] ends the integration there with
+    /// [`Status::Stopped`](crate::Status::Stopped), e.g. to change the
+    /// coordinates of the system and restart (a chart switch of a rotation
+    /// parametrization). The default goes on.
+    fn step_accepted(&mut self, _t: f64, _y: &[f64]) -> Control {
+        Control::Continue
+    }
 }
 
 impl<S: OdeSystem + ?Sized> OdeSystem for &mut S {
@@ -29,6 +40,9 @@ impl<S: OdeSystem + ?Sized> OdeSystem for &mut S {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         (**self).rhs(t, y, dy)
     }
+    fn step_accepted(&mut self, t: f64, y: &[f64]) -> Control {
+        (**self).step_accepted(t, y)
+    }
 }
 
 impl<S: OdeSystem + ?Sized> OdeSystem for Box<S> {
@@ -37,6 +51,9 @@ impl<S: OdeSystem + ?Sized> OdeSystem for Box<S> {
     }
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         (**self).rhs(t, y, dy)
+    }
+    fn step_accepted(&mut self, t: f64, y: &[f64]) -> Control {
+        (**self).step_accepted(t, y)
     }
 }
 
@@ -72,6 +89,13 @@ pub trait SecondOrderSystem {
         damping: &mut Mat<f64>,
         stiffness: &mut Mat<f64>,
     ) -> Result<(), RhsError>;
+
+    /// Called after every accepted step with the new state, once the output
+    /// points of that step have been emitted; [`Control::Stop`] ends the
+    /// integration there (see [`OdeSystem::step_accepted`]).
+    fn step_accepted(&mut self, _t: f64, _q: &[f64], _qd: &[f64]) -> Control {
+        Control::Continue
+    }
 }
 
 impl<S: SecondOrderSystem + ?Sized> SecondOrderSystem for &mut S {
@@ -99,6 +123,9 @@ impl<S: SecondOrderSystem + ?Sized> SecondOrderSystem for &mut S {
         stiffness: &mut Mat<f64>,
     ) -> Result<(), RhsError> {
         (**self).tangent(t, q, qd, qdd, mass, damping, stiffness)
+    }
+    fn step_accepted(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Control {
+        (**self).step_accepted(t, q, qd)
     }
 }
 
@@ -214,5 +241,10 @@ impl<S: SecondOrderSystem> OdeSystem for FirstOrderForm<S> {
         self.lu.solve_in_place(dqd);
         dq.copy_from_slice(qd);
         Ok(())
+    }
+
+    fn step_accepted(&mut self, t: f64, y: &[f64]) -> Control {
+        let (q, qd) = y.split_at(self.n);
+        self.system.step_accepted(t, q, qd)
     }
 }
