@@ -95,6 +95,8 @@ pub(crate) fn simulate(
             stats: traj.stats,
             wall_time: traj.wall_time,
             stopped: traj.stopped,
+            x: vec![],
+            chart_switches: vec![],
         },
         saved.description,
     ))

@@ -239,7 +239,7 @@ pub struct Dynamics {
     pub(crate) load_scale: f64,
     /// The factorized static tangent of the last static Newton step (chord steps).
     pub(crate) static_factor: Option<crate::statics::StaticFactor>,
-    evaluations: u64,
+    pub(crate) evaluations: u64,
 }
 
 impl Dynamics {
@@ -417,10 +417,8 @@ impl Dynamics {
     pub(crate) fn inertia(&mut self, mass: bool) {
         let mech = self.mech.clone();
         let n_q = mech.n_dof();
-        let x = self.kin.x();
-        let xd = self.kin.xd();
-        let xdd0 = self.kin.xdd0();
-        let fq = self.kin.f_xi();
+        let view = self.kin.first_order_view();
+        let (x, xd, xdd0, fq) = (view.x, view.xd, view.xdd0, view.f);
         self.w.copy_from_slice(&self.f);
         let asm = &mut self.asm;
         if mass {
@@ -460,8 +458,9 @@ impl Dynamics {
     /// rhs = F,qᵀ w − E,qᵀ σ.
     pub(crate) fn generalized_force(&mut self) {
         let n_q = self.mech.n_dof();
-        let fq = self.kin.f_xi().subcols(0, n_q);
-        let eq = self.kin.e_xi().subcols(0, n_q);
+        let view = self.kin.first_order_view();
+        let fq = view.f.subcols(0, n_q);
+        let eq = view.e.subcols(0, n_q);
         let mut rhs = MatMut::from_column_major_slice_mut(&mut self.rhs, n_q, 1);
         let w = MatRef::from_column_major_slice(&self.w, self.w.len(), 1);
         let sigma = MatRef::from_column_major_slice(&self.sigma, self.sigma.len(), 1);
@@ -725,12 +724,13 @@ impl Dynamics {
         let n_q = self.n_q();
         self.kinematics_at(t, q0, None)?;
         self.kin.velocities(&vec![0.0; n_q]);
-        let f = self.kin.f_xi();
+        let view = self.kin.first_order_view();
+        let f = view.f;
         let target: Vec<f64> = self
             .mech
             .initial_xd
             .iter()
-            .zip(self.kin.xd())
+            .zip(view.xd)
             .map(|(a, b)| a - b)
             .collect();
         let a = Mat::from_fn(n_q, n_q, |r, c| {

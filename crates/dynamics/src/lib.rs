@@ -36,6 +36,7 @@
 
 mod eom;
 mod linearize;
+mod momentum;
 mod nodal_eom;
 mod outputs;
 mod simulate;
@@ -54,8 +55,11 @@ pub(crate) fn fixture(name: &str) -> flexmb_model::Scene {
 pub use eom::{Dynamics, Energies};
 pub use flexmb_ode::{Control, Stats};
 pub use linearize::Linearization;
+pub use momentum::Momentum;
 pub use outputs::OutputTable;
-pub use simulate::{integrate_explicit, FirstOrder, Integrator, SimulationOptions, Trajectory};
+pub use simulate::{
+    integrate_explicit, FirstOrder, Integrator, OutputPoint, SimulationOptions, Trajectory,
+};
 pub use statics::{StaticOptions, StaticSolution};
 
 /// Failures of the dynamics layer, naming what failed.

@@ -4,10 +4,14 @@
 
 use crate::{Dynamics, DynamicsError};
 use faer::Mat;
+use flexmb_model::{ChartSwitch, Coordinate, EulerChart, Mechanism};
 use flexmb_ode::{
     Adams, AdamsOptions, Control, Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions,
     OdeSystem, Output, RhsError, SecondOrderSystem, Stats, Tolerance,
 };
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Mass, damping and stiffness tangents (M, C, K) of the residual.
@@ -81,6 +85,48 @@ pub struct Trajectory {
     pub wall_time: f64,
     /// True if stopped early by the observer.
     pub stopped: bool,
+    /// The nodal coordinates x at each output time, solved at the
+    /// integrator's own configuration there (not again after the run, which
+    /// can land on a mirrored branch of a mechanism that turned far). A
+    /// later evaluation at output `k` starts its position solve from
+    /// `x[k]` ([`Kinematics::set_guess`](flexmb_kinematics::Kinematics::set_guess)).
+    pub x: Vec<Vec<f64>>,
+    /// Chart switches of free orientation nodes during the run
+    /// ([`flexmb_model::EulerChart`]); each one restarted the integrator.
+    /// `q` and `qd` are always given in the chart the run started with.
+    pub chart_switches: Vec<ChartSwitch>,
+}
+
+impl Trajectory {
+    fn empty() -> Self {
+        Self {
+            t: vec![],
+            q: vec![],
+            qd: vec![],
+            stats: Stats::default(),
+            wall_time: 0.0,
+            stopped: false,
+            x: vec![],
+            chart_switches: vec![],
+        }
+    }
+}
+
+/// One output point of [`Dynamics::simulate_with`].
+pub struct OutputPoint<'a> {
+    /// Time.
+    pub t: f64,
+    /// q in the chart the run started with.
+    pub q: &'a [f64],
+    /// q̇ in the chart the run started with.
+    pub qd: &'a [f64],
+    /// q in the current chart (what `dynamics` takes).
+    pub q_chart: &'a [f64],
+    /// q̇ in the current chart.
+    pub qd_chart: &'a [f64],
+    /// The dynamics in the current chart, its kinematics solved at this point
+    /// to first order with velocities and accelerations (x, ε, ẋ, ε̇).
+    pub dynamics: &'a mut Dynamics,
 }
 
 /// Integrates a first-order system y' = f(t, y) with one of the explicit
@@ -145,10 +191,42 @@ fn to_rhs_error(e: DynamicsError) -> RhsError {
     }
 }
 
+/// What a segment of a charted run needs between steps: the chart checks
+/// and the configuration of the last accepted step (the warm start of the
+/// output evaluations).
+#[derive(Default)]
+struct StepWatch {
+    charts: Vec<EulerChart>,
+    /// x at the last accepted step.
+    x: Rc<RefCell<Vec<f64>>>,
+    /// (t, q, q̇) where a chart must switch.
+    switch_at: Option<(f64, Vec<f64>, Vec<f64>)>,
+}
+
+impl StepWatch {
+    fn new(dy: &Dynamics) -> Self {
+        Self {
+            charts: dy.mech.euler_charts(),
+            x: Rc::new(RefCell::new(dy.kin.x().to_vec())),
+            switch_at: None,
+        }
+    }
+
+    fn accepted(&mut self, dy: &Dynamics, t: f64, q: &[f64], qd: &[f64]) -> Control {
+        self.x.borrow_mut().copy_from_slice(dy.kin.x());
+        if self.charts.iter().any(|c| c.needs_switch(q).is_some()) {
+            self.switch_at = Some((t, q.to_vec(), qd.to_vec()));
+            return Control::Stop;
+        }
+        Control::Continue
+    }
+}
+
 /// The first-order form y = (q, q̇), ẏ = (q̇, q̈).
 pub struct FirstOrder<'a> {
     dy: &'a mut Dynamics,
     qdd: Vec<f64>,
+    watch: Option<StepWatch>,
 }
 
 impl OdeSystem for FirstOrder<'_> {
@@ -165,10 +243,18 @@ impl OdeSystem for FirstOrder<'_> {
         dy[n..].copy_from_slice(&self.qdd);
         Ok(())
     }
+    fn step_accepted(&mut self, t: f64, y: &[f64]) -> Control {
+        let n = self.dy.n_q();
+        match &mut self.watch {
+            Some(w) => w.accepted(self.dy, t, &y[..n], &y[n..]),
+            None => Control::Continue,
+        }
+    }
 }
 
 struct Residual<'a> {
     dy: &'a mut Dynamics,
+    watch: StepWatch,
 }
 
 impl SecondOrderSystem for Residual<'_> {
@@ -204,6 +290,9 @@ impl SecondOrderSystem for Residual<'_> {
         stiffness.copy_from(&k);
         Ok(())
     }
+    fn step_accepted(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Control {
+        self.watch.accepted(self.dy, t, q, qd)
+    }
 }
 
 impl Dynamics {
@@ -213,6 +302,7 @@ impl Dynamics {
         FirstOrder {
             dy: self,
             qdd: vec![0.0; n],
+            watch: None,
         }
     }
 
@@ -251,11 +341,11 @@ impl Dynamics {
     }
 
     /// Dq = E,qᵀ D E,q (E.6b) plus controller derivative gains.
-    pub(crate) fn damping_matrix(&self) -> Mat<f64> {
+    pub(crate) fn damping_matrix(&mut self) -> Mat<f64> {
         let mech = &self.mech;
         let n_q = mech.n_dof();
-        let e = self.kin.e_xi();
-        let f = self.kin.f_xi();
+        let view = self.kin.first_order_view();
+        let (e, f) = (view.e, view.f);
         let mut d = Mat::<f64>::zeros(n_q, n_q);
         for el in &mech.elements {
             let Some(dm) = el.element.damping() else {
@@ -283,7 +373,8 @@ impl Dynamics {
     }
 
     /// Integrates from (t0, q0, q̇0) to the last output time. `observer(t, q, q̇)`
-    /// is called at each output time and may stop the run (partial results are kept).
+    /// is called at each output time and may stop the run (partial results
+    /// are kept). See [`simulate_with`](Self::simulate_with).
     pub fn simulate(
         &mut self,
         t0: f64,
@@ -292,36 +383,147 @@ impl Dynamics {
         opts: &SimulationOptions,
         mut observer: impl FnMut(f64, &[f64], &[f64]) -> Control,
     ) -> Result<Trajectory, DynamicsError> {
-        let n = self.n_q();
+        self.simulate_with(t0, q0, qd0, opts, |p| observer(p.t, p.q, p.qd))
+    }
+
+    /// Integrates from (t0, q0, q̇0) to the last output time; `observer` sees
+    /// each output point with a [`Dynamics`] solved there, and may stop the
+    /// run (partial results are kept).
+    ///
+    /// Free orientation nodes (three Euler parameters as DOFs) switch their
+    /// chart when the dependent parameter gets small
+    /// ([`flexmb_model::EulerChart`]): the integrator stops after that step,
+    /// the DOF slot of the parameter that becomes dependent takes the one
+    /// that was, q and q̇ are mapped through x and ẋ, and the integration
+    /// restarts there (Adams and generalized-α restart at low order; the
+    /// evaluation counts include the restarts). A body may so turn through
+    /// any number of revolutions. The trajectory's q and q̇ are given in the
+    /// chart the run started with, and `self` is in that chart again when
+    /// this returns.
+    pub fn simulate_with(
+        &mut self,
+        t0: f64,
+        q0: &[f64],
+        qd0: &[f64],
+        opts: &SimulationOptions,
+        mut observer: impl FnMut(&mut OutputPoint<'_>) -> Control,
+    ) -> Result<Trajectory, DynamicsError> {
         let t_end = *opts
             .output_times
             .last()
             .ok_or_else(|| DynamicsError::Invalid("no output times".into()))?;
-        let out = Output::Times(opts.output_times.clone());
-        let mut traj = Trajectory {
-            t: vec![],
-            q: vec![],
-            qd: vec![],
-            stats: Stats::default(),
-            wall_time: 0.0,
-            stopped: false,
-        };
         let start = Instant::now();
+        let start_mech = self.mech.clone();
+        let mut traj = Trajectory::empty();
+        let (mut t, mut q, mut qd) = (t0, q0.to_vec(), qd0.to_vec());
+        self.kinematics_at(t, &q, None)?;
+        if let Some((q1, qd1)) = self.switch_charts(t, &q, &qd, &mut traj.chart_switches)? {
+            (q, qd) = (q1, qd1);
+        }
+        let mut times = opts.output_times.clone();
+        let mut first = true;
+        loop {
+            let seg_opts = SimulationOptions {
+                output_times: times.clone(),
+                ..opts.clone()
+            };
+            let (stats, switch_at, stopped) = self.simulate_segment(
+                t,
+                &q,
+                &qd,
+                &seg_opts,
+                &start_mech,
+                &mut traj,
+                &mut observer,
+            )?;
+            accumulate(&mut traj.stats, &stats, first);
+            first = false;
+            traj.stopped = stopped;
+            let Some((ts, qs, qds)) = switch_at else {
+                break;
+            };
+            if stopped || ts >= t_end {
+                break;
+            }
+            t = ts;
+            self.kinematics_at(t, &qs, None)?;
+            (q, qd) = self
+                .switch_charts(t, &qs, &qds, &mut traj.chart_switches)?
+                .unwrap_or((qs, qds));
+            times.retain(|&tau| tau > ts);
+            if times.is_empty() {
+                break;
+            }
+        }
+        if !Arc::ptr_eq(&self.mech, &start_mech) {
+            let x = self.kin.x().to_vec();
+            self.replace_mechanism(start_mech);
+            self.kin.set_guess(&x);
+        }
+        traj.wall_time = start.elapsed().as_secs_f64();
+        Ok(traj)
+    }
+
+    /// One integration from (t0, q0, q̇0) in the current chart, until the
+    /// last output time, a stop of the observer or a needed chart switch.
+    #[allow(clippy::too_many_arguments)]
+    fn simulate_segment(
+        &mut self,
+        t0: f64,
+        q0: &[f64],
+        qd0: &[f64],
+        opts: &SimulationOptions,
+        start_mech: &Arc<Mechanism>,
+        traj: &mut Trajectory,
+        observer: &mut impl FnMut(&mut OutputPoint<'_>) -> Control,
+    ) -> Result<(Stats, Option<(f64, Vec<f64>, Vec<f64>)>, bool), DynamicsError> {
+        let n = self.n_q();
+        let t_end = *opts.output_times.last().expect("output times");
+        let out = Output::Times(opts.output_times.clone());
+        let mut out_dy = Dynamics::new(self.mech.clone());
+        out_dy.kin.set_newton_options(self.kin.newton_options());
+        out_dy.load_factor = self.load_factor;
+        out_dy.load_scale = self.load_scale;
+        let watch = StepWatch::new(self);
+        let last_x = watch.x.clone();
+        let mut failure: Option<DynamicsError> = None;
+        let mut emit = |t: f64, q: &[f64], qd: &[f64]| -> Control {
+            out_dy.kin.set_guess(&last_x.borrow());
+            if let Err(e) = out_dy.kinematics_at(t, q, Some(qd)) {
+                failure = Some(e);
+                return Control::Stop;
+            }
+            let (qs, qds) = out_dy.in_chart_of(start_mech);
+            traj.t.push(t);
+            traj.x.push(out_dy.kin.x().to_vec());
+            let c = observer(&mut OutputPoint {
+                t,
+                q: &qs,
+                qd: &qds,
+                q_chart: q,
+                qd_chart: qd,
+                dynamics: &mut out_dy,
+            });
+            traj.q.push(qs);
+            traj.qd.push(qds);
+            c
+        };
         let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(e.to_string());
-        match opts.integrator {
+        let (stats, stopped, switch_at) = match opts.integrator {
             Integrator::Dopri5 | Integrator::Adams => {
                 let mut y0 = q0.to_vec();
                 y0.extend_from_slice(qd0);
-                let mut sys = self.first_order_system();
+                let mut sys = FirstOrder {
+                    dy: self,
+                    qdd: vec![0.0; n],
+                    watch: Some(watch),
+                };
                 let (stats, stopped) =
                     integrate_explicit(&mut sys, opts, t0, &y0, |t: f64, y: &[f64]| {
-                        traj.t.push(t);
-                        traj.q.push(y[..n].to_vec());
-                        traj.qd.push(y[n..].to_vec());
-                        observer(t, &y[..n], &y[n..])
+                        emit(t, &y[..n], &y[n..])
                     })?;
-                traj.stats = stats;
-                traj.stopped = stopped;
+                let switch_at = sys.watch.and_then(|w| w.switch_at);
+                (stats, stopped, switch_at)
             }
             Integrator::GeneralizedAlpha => {
                 let o = GeneralizedAlphaOptions {
@@ -329,20 +531,105 @@ impl Dynamics {
                     atol: Tolerance::Scalar(opts.atol),
                     ..Default::default()
                 };
-                let mut sys = Residual { dy: self };
+                let mut sys = Residual { dy: self, watch };
                 let sol = GeneralizedAlpha::new(o)
                     .solve_with(&mut sys, t0, q0, qd0, t_end, &out, |t, q, qd, _| {
-                        traj.t.push(t);
-                        traj.q.push(q.to_vec());
-                        traj.qd.push(qd.to_vec());
-                        observer(t, q, qd)
+                        emit(t, q, qd)
                     })
                     .map_err(to_err)?;
-                traj.stats = sol.stats.clone();
-                traj.stopped = !matches!(sol.status, flexmb_ode::Status::Completed);
+                let stopped = !matches!(sol.status, flexmb_ode::Status::Completed);
+                (sol.stats.clone(), stopped, sys.watch.switch_at)
             }
+        };
+        if let Some(e) = failure {
+            return Err(e);
         }
-        traj.wall_time = start.elapsed().as_secs_f64();
-        Ok(traj)
+        // a stop for a chart switch is not a stop of the observer
+        let stopped = stopped && switch_at.is_none();
+        Ok((stats, switch_at, stopped))
+    }
+
+    /// q and q̇ in the chart of `mech` (same nodal coordinates and
+    /// deformations as this dynamics' mechanism, perhaps other DOF roles),
+    /// read from the current kinematic state.
+    fn in_chart_of(&self, mech: &Mechanism) -> (Vec<f64>, Vec<f64>) {
+        let (x, xd, eps, epsd) = (self.kin.x(), self.kin.xd(), self.kin.eps(), self.kin.epsd());
+        mech.dofs
+            .iter()
+            .map(|c| match *c {
+                Coordinate::Node(i) => (x[i], xd[i]),
+                Coordinate::Def(j) => (eps[j], epsd[j]),
+            })
+            .unzip()
+    }
+
+    /// Switches every chart that is no longer good at (t, q) (kinematics
+    /// solved there): rebuilds the dynamics in the new chart, with its
+    /// position solve starting from the current configuration, and returns
+    /// q, q̇ in it. `None` if no chart needs switching.
+    fn switch_charts(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        log: &mut Vec<ChartSwitch>,
+    ) -> Result<Option<(Vec<f64>, Vec<f64>)>, DynamicsError> {
+        let charts = self.mech.euler_charts();
+        let wanted: Vec<_> = charts
+            .iter()
+            .filter_map(|c| c.needs_switch(q).map(|s| (c, s)))
+            .collect();
+        if wanted.is_empty() {
+            return Ok(None);
+        }
+        self.kinematics_at(t, q, Some(qd))?;
+        let x = self.kin.x().to_vec();
+        let mut mech = (*self.mech).clone();
+        for (c, (slot, x_new_dep)) in wanted {
+            log.push(mech.switch_chart(c, slot, x_new_dep, t));
+        }
+        let mech = Arc::new(mech);
+        let (q1, qd1) = self.in_chart_of(&mech);
+        self.replace_mechanism(mech);
+        self.kin.set_guess(&x);
+        self.kinematics_at(t, &q1, None)?;
+        Ok(Some((q1, qd1)))
+    }
+
+    /// Rebuilds this dynamics for `mech` (the same scene with other DOF
+    /// roles), keeping its settings: Newton options, load factor and scale,
+    /// evaluation count.
+    fn replace_mechanism(&mut self, mech: Arc<Mechanism>) {
+        let newton = self.kin.newton_options();
+        let (lf, ls, ev) = (self.load_factor, self.load_scale, self.evaluations);
+        *self = Dynamics::new(mech);
+        self.kin.set_newton_options(newton);
+        self.load_factor = lf;
+        self.load_scale = ls;
+        self.evaluations = ev;
+    }
+}
+
+/// Adds the counts of a restarted segment to the run's statistics.
+fn accumulate(total: &mut Stats, seg: &Stats, first: bool) {
+    if first {
+        *total = seg.clone();
+        return;
+    }
+    total.rhs_evals += seg.rhs_evals;
+    total.steps_accepted += seg.steps_accepted;
+    total.steps_rejected += seg.steps_rejected;
+    total.newton_iterations += seg.newton_iterations;
+    total.newton_failures += seg.newton_failures;
+    total.jacobian_evals += seg.jacobian_evals;
+    total.lu_decompositions += seg.lu_decompositions;
+    if seg.steps_accepted > 0 {
+        total.last_step = seg.last_step;
+        total.min_step = if total.min_step == 0.0 {
+            seg.min_step
+        } else {
+            total.min_step.min(seg.min_step)
+        };
+        total.max_step = total.max_step.max(seg.max_step);
     }
 }

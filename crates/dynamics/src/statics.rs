@@ -114,11 +114,11 @@ impl Dynamics {
     /// element over the columns where the element's rows of E,q are not all
     /// zero (with deformation DOFs of a serial chain that is the element's
     /// own DOFs: Kq is then assembled in O(n) instead of an n_ε × n_q² product).
-    pub(crate) fn structural_stiffness(&self) -> Mat<f64> {
+    pub(crate) fn structural_stiffness(&mut self) -> Mat<f64> {
         let mech = &self.mech;
         let n_q = mech.n_dof();
-        let e = self.kin.e_xi();
-        let f = self.kin.f_xi();
+        let view = self.kin.first_order_view();
+        let (e, f) = (view.e, view.f);
         let mut gains = vec![0.0; mech.n_eps()];
         for c in &mech.controllers {
             if let Coordinate::Def(j) = c.on {
@@ -204,11 +204,11 @@ impl Dynamics {
 
     /// F,qᵀ (∂f/∂x) F,q for position-dependent loads (consistent gravity on
     /// rotating elements, moments on Euler parameters).
-    pub(crate) fn load_stiffness(&self, t: f64) -> Mat<f64> {
+    pub(crate) fn load_stiffness(&mut self, t: f64) -> Mat<f64> {
         let mech = &self.mech;
         let n_q = mech.n_dof();
-        let f = self.kin.f_xi();
-        let x = self.kin.x();
+        let view = self.kin.first_order_view();
+        let (f, x) = (view.f, view.x);
         let mut l = Mat::<f64>::zeros(n_q, n_q);
         let mut add = |idx: &[usize], d: &[f64], n: usize| {
             let fe = Mat::from_fn(n, n_q, |a, c| f[(idx[a], c)]);

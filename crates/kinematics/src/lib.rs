@@ -52,6 +52,27 @@ use faer::Mat;
 use flexmb_model::{Coordinate, ERole, Mechanism, XRole};
 use std::sync::Arc;
 
+/// A read-only view of the kinematic state whose F,ξ and E,ξ are of its
+/// configuration ([`Kinematics::first_order_view`]). The rates are those of
+/// the last [`Kinematics::velocities`] and [`Kinematics::accelerations`].
+#[derive(Clone, Copy, Debug)]
+pub struct FirstOrderView<'a> {
+    /// Nodal coordinates x.
+    pub x: &'a [f64],
+    /// Deformations ε.
+    pub eps: &'a [f64],
+    /// ẋ.
+    pub xd: &'a [f64],
+    /// ε̇.
+    pub epsd: &'a [f64],
+    /// ẍ for q̈ = 0.
+    pub xdd0: &'a [f64],
+    /// F,ξ (n_x × (n_q + n_u)).
+    pub f: &'a Mat<f64>,
+    /// E,ξ (n_ε × (n_q + n_u)).
+    pub e: &'a Mat<f64>,
+}
+
 /// Newton settings of the position solve.
 #[derive(Clone, Copy, Debug)]
 pub struct NewtonOptions {
@@ -353,6 +374,10 @@ impl Kinematics {
     pub fn set_newton_options(&mut self, o: NewtonOptions) {
         self.opts = o;
     }
+    /// The Newton options.
+    pub fn newton_options(&self) -> NewtonOptions {
+        self.opts
+    }
     /// The mechanism.
     pub fn mechanism(&self) -> &Arc<Mechanism> {
         &self.mech
@@ -381,13 +406,43 @@ impl Kinematics {
     pub fn iterations(&self) -> usize {
         self.iterations
     }
-    /// F,ξ (n_x × (n_q + n_u)), valid after [`first_order`](Self::first_order).
-    pub fn f_xi(&self) -> &Mat<f64> {
+    /// F,ξ (n_x × (n_q + n_u)) at the current configuration. Computed here
+    /// ([`first_order`](Self::first_order)) if a solve or a new guess since
+    /// the last one left it stale, so it is never of another configuration.
+    pub fn f_xi(&mut self) -> &Mat<f64> {
+        self.ensure_first_order();
         &self.f
     }
-    /// E,ξ (n_ε × (n_q + n_u)), valid after [`first_order`](Self::first_order).
-    pub fn e_xi(&self) -> &Mat<f64> {
+    /// E,ξ (n_ε × (n_q + n_u)) at the current configuration (see
+    /// [`f_xi`](Self::f_xi)).
+    pub fn e_xi(&mut self) -> &Mat<f64> {
+        self.ensure_first_order();
         &self.e
+    }
+    /// The current state with F,ξ and E,ξ of the current configuration
+    /// (computed first if stale, see [`f_xi`](Self::f_xi)), for reading them
+    /// together with x, ε and the rates.
+    pub fn first_order_view(&mut self) -> FirstOrderView<'_> {
+        self.ensure_first_order();
+        FirstOrderView {
+            x: &self.x,
+            eps: &self.eps,
+            xd: &self.xd,
+            epsd: &self.epsd,
+            xdd0: &self.xdd0,
+            f: &self.f,
+            e: &self.e,
+        }
+    }
+    /// Whether F,ξ and E,ξ are of the current configuration (else the next
+    /// read computes them).
+    pub fn first_order_is_current(&self) -> bool {
+        self.first_order_valid
+    }
+    fn ensure_first_order(&mut self) {
+        if !self.first_order_valid {
+            self.first_order();
+        }
     }
     /// ẋ of the last [`velocities`](Self::velocities) call.
     pub fn xd(&self) -> &[f64] {
@@ -421,6 +476,7 @@ impl Kinematics {
         self.x.copy_from_slice(x);
         self.have_solution = false;
         self.lu_at_x = false;
+        self.first_order_valid = false;
     }
 
     /// Factorizations of the kinematic Jacobian so far (a cost measure).
@@ -998,8 +1054,10 @@ impl Kinematics {
         }
     }
 
-    /// ẋ = F,ξ ξ̇ and ε̇ = E,ξ ξ̇ with ξ̇ = (q̇, u̇(t)). Call after [`first_order`](Self::first_order).
+    /// ẋ = F,ξ ξ̇ and ε̇ = E,ξ ξ̇ with ξ̇ = (q̇, u̇(t)), with F,ξ and E,ξ of the
+    /// current configuration (computed first if stale).
     pub fn velocities(&mut self, qd: &[f64]) {
+        self.ensure_first_order();
         let (n_q, n_u) = (self.n_q, self.n_u);
         self.xid[..n_q].copy_from_slice(qd);
         for k in 0..n_u {
@@ -1271,6 +1329,7 @@ impl Kinematics {
     /// ∂ε̇/∂q (n_ε × n_q). Column k solves J X1_dep = −D_c,xx\[F,q e_k, ẋ\].
     pub fn velocity_sensitivity(&mut self) -> (Mat<f64>, Mat<f64>) {
         self.ensure_lu_at_x();
+        self.ensure_first_order();
         let mech = self.mech.clone();
         let (n_q, n_x, n_e) = (self.n_q, mech.n_x(), mech.n_eps());
         let n_c = mech.constraint_rows.len();
@@ -1303,6 +1362,7 @@ impl Kinematics {
     /// J X2_dep = −(D_c,xx\[F e_k, ẍ\] + D_c,xxx\[F e_k, ẋ, ẋ\] + 2 D_c,xx\[X1 e_k, ẋ\]).
     pub fn acceleration_sensitivity(&mut self, xdd: &[f64], x1: &Mat<f64>) -> Mat<f64> {
         self.ensure_lu_at_x();
+        self.ensure_first_order();
         let mech = self.mech.clone();
         let (n_q, n_x) = (self.n_q, mech.n_x());
         let n_c = mech.constraint_rows.len();
@@ -1444,6 +1504,7 @@ impl Kinematics {
     /// Call after [`first_order`](Self::first_order).
     pub fn second_order_contraction(&mut self, w: &[f64], sigma: &[f64]) -> Mat<f64> {
         self.ensure_lu_at_x();
+        self.ensure_first_order();
         let mech = self.mech.clone();
         let n_q = self.n_q;
         let n_c = mech.constraint_rows.len();

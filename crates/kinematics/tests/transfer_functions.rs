@@ -147,7 +147,8 @@ fn geometric_contraction_matches_differences() {
         let gen = |k: &mut Kinematics, q: &[f64]| -> Vec<f64> {
             k.solve(q, 0.0).unwrap();
             k.first_order();
-            let (f, e) = (k.f_xi(), k.e_xi());
+            let v = k.first_order_view();
+            let (f, e) = (v.f, v.e);
             (0..nq)
                 .map(|c| {
                     (0..nx).map(|i| f[(i, c)] * w[i]).sum::<f64>()
@@ -258,7 +259,8 @@ fn adjoint_transfer_matches_the_explicit_product() {
         let mut adj_s = vec![0.0; n_xi];
         k.transfer_transpose_times(&ys, &mut adj_s);
         k.first_order();
-        let (f, e) = (k.f_xi(), k.e_xi());
+        let v = k.first_order_view();
+        let (f, e) = (v.f, v.e);
         for c in 0..n_xi {
             let fy: f64 = (0..mech.n_x()).map(|i| f[(i, c)] * y[i]).sum();
             let es: f64 = (0..mech.n_eps()).map(|j| e[(j, c)] * s[j]).sum();
@@ -395,5 +397,68 @@ fn a_far_jump_by_continuation_gives_the_configuration_and_derivatives_of_small_s
                 assert!((a - b).abs() <= 1e-8 * xs, "chord {chord}: F,ξ {a} vs {b}");
             }
         }
+    }
+}
+
+/// F,ξ, E,ξ and the velocities read after a solve that did not compute them
+/// (a chord solve, as one evaluation of the equations of motion does, or a
+/// new guess) are of the new configuration, never of the one before. Before
+/// this was enforced, `nodal_mode_shapes` after `Dynamics::accelerations`
+/// read F,q of an older configuration.
+#[test]
+fn derivatives_are_never_of_an_older_configuration() {
+    for mut k in [
+        kinematics("straight_guidance_spatial.ron", DofChoice::Deformations),
+        sparse_kinematics("straight_guidance_spatial.ron", DofChoice::Deformations),
+    ] {
+        let mut rng = StdRng::seed_from_u64(11);
+        let q1 = deflected(&k, &mut rng, 2e-3);
+        let q2 = deflected(&k, &mut rng, 2e-3);
+        let n_q = q1.len();
+        // the reference at q2, from a fresh solve with first order
+        let mut fresh = kinematics("straight_guidance_spatial.ron", DofChoice::Deformations);
+        fresh.solve(&q2, 0.0).unwrap();
+        fresh.first_order();
+        let (f_ref, e_ref) = (fresh.f_xi().to_owned(), fresh.e_xi().to_owned());
+        let qd = vec![0.3; n_q];
+        fresh.velocities(&qd);
+        let xd_ref = fresh.xd().to_vec();
+        // first order at q1, then only a chord solve at q2
+        k.solve(&q1, 0.0).unwrap();
+        k.first_order();
+        let f_old = k.f_xi().to_owned();
+        k.solve_chord(&q2, 0.0).unwrap();
+        assert!(!k.first_order_is_current(), "a solve must invalidate F,ξ");
+        let scale = f_ref.norm_max();
+        let diff_old = (&f_old - &f_ref).norm_max();
+        assert!(
+            diff_old > 1e-6 * scale,
+            "the test needs configurations with other F,ξ ({diff_old:e})"
+        );
+        let df = (k.f_xi() - &f_ref).norm_max();
+        let de = (k.e_xi() - &e_ref).norm_max();
+        assert!(
+            df <= 1e-9 * scale,
+            "F,ξ after a chord solve differs by {df:e} from the one at its configuration"
+        );
+        assert!(
+            de <= 1e-9 * e_ref.norm_max().max(1.0),
+            "E,ξ differs by {de:e}"
+        );
+        // velocities after a solve without first order
+        k.solve_chord(&q1, 0.0).unwrap();
+        k.solve_chord(&q2, 0.0).unwrap();
+        k.velocities(&qd);
+        let dv = k
+            .xd()
+            .iter()
+            .zip(&xd_ref)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let sv = xd_ref.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(dv <= 1e-9 * sv, "ẋ differs by {dv:e} of {sv:e}");
+        // a new guess invalidates too
+        k.set_guess(&x_at(&mut fresh, &q1));
+        assert!(!k.first_order_is_current());
     }
 }

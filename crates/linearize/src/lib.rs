@@ -43,11 +43,12 @@ pub use sweep::{sweep, SweepOptions, SweepParameter, SweepPoint};
 
 use faer::Mat;
 
-/// Mode shapes in nodal coordinates: F,q V (n_x × k), at the kinematic state
-/// of the last evaluation of `dy`.
-pub fn nodal_mode_shapes(dy: &flexmb_dynamics::Dynamics, vectors: &Mat<f64>) -> Mat<f64> {
+/// Mode shapes in nodal coordinates: F,q V (n_x × k), at the configuration of
+/// the last evaluation of `dy` (F,q is computed there if that evaluation did
+/// not need it, e.g. after `Dynamics::accelerations`).
+pub fn nodal_mode_shapes(dy: &mut flexmb_dynamics::Dynamics, vectors: &Mat<f64>) -> Mat<f64> {
     let n_q = vectors.nrows();
-    let f = dy.kinematics().f_xi().subcols(0, n_q);
+    let f = dy.kinematics_mut().f_xi().subcols(0, n_q);
     f * vectors
 }
 

@@ -76,7 +76,7 @@ fn mode_shapes_in_nodal_coordinates_move_the_body_in_x_for_the_first_mode() {
     let q0 = mech.q0();
     let lin = dy.linearize_at_rest(0.0, &q0).unwrap();
     let modes = undamped_modes(&lin, 2).unwrap();
-    let shapes = nodal_mode_shapes(&dy, &modes.vectors);
+    let shapes = nodal_mode_shapes(&mut dy, &modes.vectors);
     let sx = mech.node("S").unwrap().position.clone();
     // mode 1: translation of the body along x; mode 2: out-of-plane (z)
     let (ux, uy, uz) = (

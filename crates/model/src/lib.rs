@@ -28,6 +28,7 @@
 #![warn(missing_docs)]
 
 mod build;
+mod chart;
 mod error;
 mod loads;
 mod mechanism;
@@ -35,6 +36,7 @@ mod roles;
 mod scene;
 mod time_function;
 
+pub use chart::{ChartSwitch, EulerChart, CHART_SWITCH_RATIO};
 pub use error::ModelError;
 pub use mechanism::*;
 pub use scene::*;
