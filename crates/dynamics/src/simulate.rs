@@ -201,6 +201,9 @@ struct StepWatch {
     x: Rc<RefCell<Vec<f64>>>,
     /// (t, q, q̇) where a chart must switch.
     switch_at: Option<(f64, Vec<f64>, Vec<f64>)>,
+    /// The last evaluation that failed recoverably (the integrator retried
+    /// with a smaller step): the reason to give if the run fails after it.
+    last_failure: Option<(f64, String)>,
 }
 
 impl StepWatch {
@@ -209,6 +212,27 @@ impl StepWatch {
             charts: dy.mech.euler_charts(),
             x: Rc::new(RefCell::new(dy.kin.x().to_vec())),
             switch_at: None,
+            last_failure: None,
+        }
+    }
+
+    /// Converts an evaluation failure, noting a recoverable one.
+    fn failed(&mut self, t: f64, e: DynamicsError) -> RhsError {
+        let r = to_rhs_error(e);
+        if r.is_recoverable() {
+            self.last_failure = Some((t, r.message().to_string()));
+        }
+        r
+    }
+
+    /// An integration error with the last recoverable evaluation failure
+    /// when there was one: a step-size underflow names its cause.
+    fn with_cause(&self, e: DynamicsError) -> DynamicsError {
+        match (&self.last_failure, e) {
+            (Some((t, m)), DynamicsError::Integration(msg)) => DynamicsError::Integration(format!(
+                "{msg}; the last evaluation that failed (at t = {t:e}): {m}"
+            )),
+            (_, e) => e,
         }
     }
 
@@ -236,9 +260,12 @@ impl OdeSystem for FirstOrder<'_> {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         let n = self.dy.n_q();
         let (q, qd) = y.split_at(n);
-        self.dy
-            .accelerations(t, q, qd, &mut self.qdd)
-            .map_err(to_rhs_error)?;
+        if let Err(e) = self.dy.accelerations(t, q, qd, &mut self.qdd) {
+            return Err(match &mut self.watch {
+                Some(w) => w.failed(t, e),
+                None => to_rhs_error(e),
+            });
+        }
         dy[..n].copy_from_slice(qd);
         dy[n..].copy_from_slice(&self.qdd);
         Ok(())
@@ -269,7 +296,9 @@ impl SecondOrderSystem for Residual<'_> {
         qdd: &[f64],
         r: &mut [f64],
     ) -> Result<(), RhsError> {
-        self.dy.residual(t, q, qd, qdd, r).map_err(to_rhs_error)
+        self.dy
+            .residual(t, q, qd, qdd, r)
+            .map_err(|e| self.watch.failed(t, e))
     }
     fn tangent(
         &mut self,
@@ -284,7 +313,7 @@ impl SecondOrderSystem for Residual<'_> {
         let (m, d, k) = self
             .dy
             .tangent_matrices(t, q, qd, qdd)
-            .map_err(to_rhs_error)?;
+            .map_err(|e| self.watch.failed(t, e))?;
         mass.copy_from(&m);
         damping.copy_from(&d);
         stiffness.copy_from(&k);
@@ -518,11 +547,18 @@ impl Dynamics {
                     qdd: vec![0.0; n],
                     watch: Some(watch),
                 };
-                let (stats, stopped) =
-                    integrate_explicit(&mut sys, opts, t0, &y0, |t: f64, y: &[f64]| {
-                        emit(t, &y[..n], &y[n..])
-                    })?;
-                let switch_at = sys.watch.and_then(|w| w.switch_at);
+                let run = integrate_explicit(&mut sys, opts, t0, &y0, |t: f64, y: &[f64]| {
+                    emit(t, &y[..n], &y[n..])
+                });
+                let watch = sys.watch.expect("set above");
+                let (stats, stopped) = match run {
+                    Ok(r) => r,
+                    Err(DynamicsError::Integration(m)) => {
+                        return Err(watch.with_cause(DynamicsError::Integration(m)))
+                    }
+                    Err(e) => return Err(e),
+                };
+                let switch_at = watch.switch_at;
                 (stats, stopped, switch_at)
             }
             Integrator::GeneralizedAlpha => {
@@ -536,7 +572,7 @@ impl Dynamics {
                     .solve_with(&mut sys, t0, q0, qd0, t_end, &out, |t, q, qd, _| {
                         emit(t, q, qd)
                     })
-                    .map_err(to_err)?;
+                    .map_err(|e| sys.watch.with_cause(to_err(e)))?;
                 let stopped = !matches!(sol.status, flexmb_ode::Status::Completed);
                 (sol.stats.clone(), stopped, sys.watch.switch_at)
             }

@@ -119,7 +119,7 @@ pub enum KinematicsError {
     },
     /// The dependent Euler parameter of a node with the other three as DOFs
     /// approaches zero: the parametrization is singular there.
-    #[error("{coordinate} = {value:.3}, the Euler parameter made dependent by the normalization, approaches zero (a rotation near 180° from the reference): this choice of nodal DOFs cannot describe it; use deformation DOFs or another dependent component")]
+    #[error("{coordinate} = {value:.3}, the Euler parameter made dependent by the normalization, approaches zero (the node is turned near 180° from where that chart was chosen): a simulation switches charts after each step (flexmb_model::EulerChart), but statics, sweeps and reduced models keep the chart of the reference configuration and cannot describe this rotation; keep the node within ±180° of its reference there, or give the rotation to a hinge deformation")]
     EulerParameterDegenerate {
         /// The coordinate.
         coordinate: String,
