@@ -167,8 +167,8 @@ fn generalized_alpha_sdof_error(
 /// oscillator (ω = 1000, q(0) = 0.1, so |q| ≤ 0.1 and |q̇| ≤ 100) over
 /// [0, 0.1] with the CLI's default atol = 1e-6. The position scales
 /// atol + rtol·|q| hardly change between rtol 1e-6 and 1e-8; the velocity
-/// scales fall from 1e-4 to 2e-6. Measured: 5 148 and 15 271 steps, q̇
-/// errors 0.57 and 0.065, q errors 5.8e-4 and 6.6e-5. With the position
+/// scales fall from 1e-4 to 2e-6. Measured: 5 151 and 15 270 steps, q̇
+/// errors 0.56 and 0.065, q errors 5.7e-4 and 6.6e-5. With the position
 /// error alone in the norm (before) both runs took the same steps to within
 /// 2 % (1 922 and 1 954) and had the same errors (q̇ 2.8 and 2.7). We assert
 /// at least 2× the steps and at least 4× smaller errors in q and q̇.
@@ -188,8 +188,8 @@ fn generalized_alpha_rtol_changes_the_steps() {
 /// q̈ + 0.1 q̇ + 4 q = sin t, q(0) = 1, over [0, 10]. With the error
 /// controlled per step (e ∝ h³ ≤ tol, N ∝ tol^(−1/3) steps) the global error
 /// goes as tol^(2/3). Measured for rtol = 1e-3 … 1e-7: max q errors 2.7e-2,
-/// 5.9e-3, 1.2e-3, 2.6e-4, 5.5e-5, q̇ errors 5.4e-2, 1.2e-2, 2.4e-3,
-/// 5.0e-4, 1.1e-4, with 135, 304, 672, 1 477, 3 228 steps (with the
+/// 5.9e-3, 1.2e-3, 2.6e-4, 5.4e-5, q̇ errors 5.4e-2, 1.1e-2, 2.4e-3,
+/// 5.0e-4, 1.1e-4, with 136, 305, 672, 1 478, 3 232 steps (with the
 /// position error alone, before: q̇ errors 9.1e-2 … 2.7e-4, above the bound
 /// at rtol 1e-4). We assert a monotone decrease of both errors, more steps
 /// for every smaller rtol, errors ≤ 10·rtol^(2/3), and at least a factor 300
