@@ -104,7 +104,8 @@
 //! made, so that the factorization can be reused. As in `ode45`, a step
 //! within 10% of the remaining interval is stretched to end exactly at
 //! `t_end`. The control is per step: the global error is typically a few
-//! times to a few ten times the tolerance (see `tests/convergence.rs`).
+//! times to a few hundred times the tolerance, growing as `tol^(−1/3)`
+//! (27× at 1e-3 and 540× at 1e-7 in `tests/convergence.rs`).
 //!
 //! The initial acceleration solves `M q̈_0 = −g(t_0, q_0, q̇_0, 0)` (exact
 //! when `g` is affine in `q̈`), unless given.
