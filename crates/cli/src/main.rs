@@ -4,6 +4,7 @@
 //! options), 130 interrupted (partial results are written).
 
 mod coords;
+mod finite;
 mod path;
 mod reduce;
 mod reduced;
@@ -262,6 +263,11 @@ fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure>
     let mut kin = flexmb_kinematics::Kinematics::new(mech.clone());
     kin.solve(&sol.q, t)
         .map_err(|e| Failure::Compute(e.to_string()))?;
+    let what = "static equilibrium";
+    finite::check(what, kin.x().iter().copied(), |i| mech.x_names[i].clone())?;
+    finite::check(what, kin.eps().iter().copied(), |j| {
+        mech.eps_names[j].clone()
+    })?;
     let mut rows = vec![];
     for n in &mech.nodes {
         let d: Vec<String> = n
@@ -397,22 +403,32 @@ fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), 
         .map_err(|e| Failure::Compute(e.to_string()))?;
     let modes =
         flexmb_linearize::undamped_modes(&lin, k).map_err(|e| Failure::Compute(e.to_string()))?;
+    let at = if static_first {
+        " at the static equilibrium"
+    } else {
+        " at the reference configuration"
+    };
+    let frequencies = modes.frequencies_hz();
+    finite::check(&format!("eig{at}"), frequencies.iter().copied(), |i| {
+        format!("the undamped eigenfrequency of mode {}", i + 1)
+    })?;
     println!("{}", mech.summary());
-    println!(
-        "undamped eigenfrequencies (Hz){}:",
-        if static_first {
-            " at the static equilibrium"
-        } else {
-            " at the reference configuration"
-        }
-    );
-    for (i, f) in modes.frequencies_hz().iter().enumerate() {
+    println!("undamped eigenfrequencies (Hz){at}:");
+    for (i, f) in frequencies.iter().enumerate() {
         println!("  {:>3}  {f:>14.6}", i + 1);
     }
     let has_damping = lin.d.col_iter().any(|c| c.iter().any(|v| *v != 0.0));
     if has_damping {
         let d =
             flexmb_linearize::damped_modes(&lin).map_err(|e| Failure::Compute(e.to_string()))?;
+        let values = d
+            .iter()
+            .take(k)
+            .flat_map(|m| [m.frequency_hz, m.damping_ratio]);
+        finite::check(&format!("eig{at}"), values, |i| {
+            let what = ["frequency", "damping ratio"][i % 2];
+            format!("the {what} of damped mode {}", i / 2 + 1)
+        })?;
         println!("damped modes (frequency Hz, damping ratio):");
         for (i, m) in d.iter().take(k).enumerate() {
             println!(
@@ -425,7 +441,12 @@ fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), 
     }
     if buckling {
         match flexmb_linearize::buckling_factors(&lin, 3.min(k)) {
-            Ok(mu) => println!("buckling load factors: {mu:?}"),
+            Ok(mu) => {
+                finite::check(&format!("eig{at}"), mu.iter().copied(), |i| {
+                    format!("buckling load factor {}", i + 1)
+                })?;
+                println!("buckling load factors: {mu:?}")
+            }
             Err(e) => println!("buckling: {e}"),
         }
     }

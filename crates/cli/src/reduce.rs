@@ -6,7 +6,7 @@
 //! configuration and, for the SVD methods, the singular values.
 
 use crate::report::{count_bar, linspace};
-use crate::{coords, io_err, Failure};
+use crate::{coords, finite, io_err, Failure};
 use clap::ValueEnum;
 use flexmb_dynamics::Dynamics;
 use flexmb_linearize::{sweep, undamped_modes, SweepOptions, SweepParameter, SweepPoint};
@@ -453,6 +453,11 @@ fn report_singular_values(sv: &[SingularValues], model: &Path) -> Result<Vec<Pat
             .collect::<Vec<_>>()
             .join(" ")
     };
+    for s in sv {
+        finite::check("reduce", s.relative.iter().copied(), |i| {
+            format!("relative singular value {} of {}", i + 1, s.label)
+        })?;
+    }
     println!("relative singular values (fraction of their sum):");
     for s in sv {
         let discarded = s
@@ -588,6 +593,12 @@ pub(crate) fn reduce(a: &ReduceArgs) -> Result<(), Failure> {
             ""
         }
     );
+    finite::check("reduce", reduced.iter().copied(), |i| {
+        format!("the reduced eigenfrequency of mode {}", i + 1)
+    })?;
+    finite::check("reduce", full.iter().copied(), |i| {
+        format!("the unreduced eigenfrequency of mode {}", i + 1)
+    })?;
     println!("  mode        reduced       unreduced  difference");
     let mut rows = vec![];
     for (i, f) in reduced.iter().enumerate() {

@@ -2,7 +2,7 @@
 //! response table (`outputs.csv`/`.svg`, node paths), the eigenfrequency
 //! sweep (`eigenfrequencies.csv`/`.svg`) and progress bars.
 
-use crate::{io_err, Failure};
+use crate::{finite, io_err, Failure};
 use flexmb_dynamics::{Dynamics, OutputTable};
 use flexmb_plot::{write_csv, Plot, Series};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -84,6 +84,7 @@ pub(crate) fn write_outputs(
     }
     let mut header = vec!["t".to_string()];
     header.extend(table.header.iter().cloned());
+    finite::check_table("simulate outputs", &header, &rows)?;
     let csv = out.join("outputs.csv");
     write_csv(&csv, comments, &header, &rows).map_err(|e| io_err(e, &csv))?;
     let t: Vec<f64> = rows.iter().map(|r| r[0]).collect();
@@ -136,6 +137,15 @@ pub(crate) fn write_frequency_sweep(
     comments: &[String],
     out: &Path,
 ) -> Result<(), Failure> {
+    for (s, f) in sw.s.iter().zip(&sw.frequencies) {
+        finite::check("sweep", std::iter::once(*s).chain(f.iter().copied()), |i| {
+            let at = format!("at {} = {s}", sw.parameter);
+            match i {
+                0 => format!("the sweep parameter {}", sw.parameter),
+                i => format!("the eigenfrequency of mode {i} {at}"),
+            }
+        })?;
+    }
     std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
     let mut header = vec![sw.parameter.clone()];
     header.extend((1..=sw.modes).map(|i| format!("f{i}_hz")));

@@ -22,6 +22,7 @@ use serde::{Deserialize, Serialize};
 
 /// A group of nodal coordinates an element connects to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Slot {
     /// A planar point (x, y).
     Position2,
@@ -54,6 +55,7 @@ impl Slot {
 
 /// Options of the beam elements.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BeamOptions {
     /// Second-order elongation terms coupling bending into elongation: the
     /// planar shortening term of (5.3a), and its spatial counterpart ("bowing").

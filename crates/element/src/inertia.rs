@@ -27,6 +27,7 @@ pub(crate) const MAX_W: usize = 12 + MAX_MODES;
 /// How absolute nodal velocities are expressed in the co-rotational frame
 /// (thesis §2.3.3).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum VelocityTransform {
     /// B1 (2.24): everything in the frame attached to node p.
     B1,

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 /// A linear elastic isotropic material.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Material {
     /// Young's modulus E (Pa).
     pub e: f64,
@@ -31,16 +32,30 @@ impl Material {
     pub fn poisson(&self) -> f64 {
         self.e / (2.0 * self.g) - 1.0
     }
-    /// Checks that E, G are positive and ρ non-negative, all finite.
+    /// Checks that E, G are positive and ρ non-negative, all finite, and that
+    /// the Poisson's ratio E/(2G) − 1 they imply lies in (−1, 0.5), the range
+    /// of an isotropic elastic material (G > E/3).
     pub fn validate(&self) -> Result<(), ElementError> {
         positive("Young's modulus E", self.e)?;
         positive("shear modulus G", self.g)?;
-        non_negative("density rho", self.rho)
+        non_negative("density rho", self.rho)?;
+        let nu = self.poisson();
+        if !(nu > -1.0 && nu < 0.5) {
+            return Err(ElementError::InvalidProperty {
+                what: "shear modulus G".into(),
+                value: self.g,
+                why: format!(
+                    "implies Poisson's ratio E/(2G) − 1 = {nu:.4}, outside (−1, 0.5) (G must exceed E/3)"
+                ),
+            });
+        }
+        Ok(())
     }
 }
 
 /// Cross-section properties used by the beam elements.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SectionProperties {
     /// Area A (m²).
     pub area: f64,
@@ -61,20 +76,36 @@ impl SectionProperties {
     pub fn polar(&self) -> f64 {
         self.iy + self.iz
     }
-    /// Checks positivity and finiteness (shear factors may be infinite).
+    /// Checks positivity and finiteness (shear factors may be infinite), and
+    /// the bounds every real cross-section obeys: the torsion constant J is at
+    /// most the polar moment Iy + Iz (equal for a circle or a circular tube),
+    /// and a finite shear correction factor is at most 1 (5/6 for a rectangle).
     pub fn validate(&self) -> Result<(), ElementError> {
-        positive("section area", self.area)?;
-        positive("section Iy", self.iy)?;
-        positive("section Iz", self.iz)?;
-        positive("section torsion constant J", self.j)?;
-        for (n, v) in [("shear factor ky", self.ky), ("shear factor kz", self.kz)] {
-            if v.is_nan() || v <= 0.0 {
+        positive("section area `area`", self.area)?;
+        positive("section second moment `iy`", self.iy)?;
+        positive("section second moment `iz`", self.iz)?;
+        positive("section torsion constant `j`", self.j)?;
+        for (n, v) in [
+            ("shear factor `ky`", self.ky),
+            ("shear factor `kz`", self.kz),
+        ] {
+            if v.is_nan() || v <= 0.0 || (v.is_finite() && v > 1.0) {
                 return Err(ElementError::InvalidProperty {
                     what: n.into(),
                     value: v,
-                    why: "must be positive (use infinity for Euler–Bernoulli)".into(),
+                    why: "must lie in (0, 1] (about 5/6 for a rectangle; use inf for Euler–Bernoulli)".into(),
                 });
             }
+        }
+        let polar = self.polar();
+        if self.j > polar * (1.0 + 1e-9) {
+            return Err(ElementError::InvalidProperty {
+                what: "section torsion constant `j`".into(),
+                value: self.j,
+                why: format!(
+                    "exceeds the polar moment Iy + Iz = {polar:e}, which bounds it for every cross-section"
+                ),
+            });
         }
         Ok(())
     }
@@ -88,6 +119,7 @@ impl SectionProperties {
 
 /// A cross-section shape from which [`SectionProperties`] follow.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum SectionShape {
     /// A solid rectangle with side `by` along local y and `bz` along local z.
     Rectangle {
@@ -120,8 +152,8 @@ impl SectionShape {
     pub fn properties(&self, nu: f64) -> Result<SectionProperties, ElementError> {
         let p = match *self {
             SectionShape::Rectangle { by, bz } => {
-                positive("rectangle side by", by)?;
-                positive("rectangle side bz", bz)?;
+                positive("rectangle side `by`", by)?;
+                positive("rectangle side `bz`", bz)?;
                 let k = 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu);
                 SectionProperties {
                     area: by * bz,
@@ -133,7 +165,7 @@ impl SectionShape {
                 }
             }
             SectionShape::Circle { d } => {
-                positive("circle diameter", d)?;
+                positive("circle diameter `d`", d)?;
                 let i = std::f64::consts::PI * d.powi(4) / 64.0;
                 let k = 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu);
                 SectionProperties {
@@ -146,13 +178,13 @@ impl SectionShape {
                 }
             }
             SectionShape::Tube { d_outer, d_inner } => {
-                positive("tube outer diameter", d_outer)?;
-                non_negative("tube inner diameter", d_inner)?;
+                positive("tube outer diameter `d_outer`", d_outer)?;
+                non_negative("tube inner diameter `d_inner`", d_inner)?;
                 if d_inner >= d_outer {
                     return Err(ElementError::InvalidProperty {
-                        what: "tube inner diameter".into(),
+                        what: "tube inner diameter `d_inner`".into(),
                         value: d_inner,
-                        why: format!("must be smaller than the outer diameter {d_outer}"),
+                        why: format!("must be smaller than the outer diameter `d_outer` = {d_outer} (a wall thickness between 0 and half the outer diameter)"),
                     });
                 }
                 let pi = std::f64::consts::PI;
@@ -241,7 +273,7 @@ mod tests {
         let e = SectionShape::Rectangle { by: 0.0, bz: 1.0 }
             .properties(0.3)
             .unwrap_err();
-        assert!(e.to_string().contains("rectangle side by"));
+        assert!(e.to_string().contains("rectangle side `by`"));
         let e = SectionShape::Tube {
             d_outer: 1.0,
             d_inner: 2.0,
@@ -256,5 +288,39 @@ mod tests {
         }
         .validate()
         .is_err());
+    }
+
+    #[test]
+    fn unphysical_properties_are_rejected_with_the_field() {
+        let ok = SectionProperties {
+            area: 1e-4,
+            iy: 1e-9,
+            iz: 2e-9,
+            j: 1e-9,
+            ky: 5.0 / 6.0,
+            kz: f64::INFINITY,
+        };
+        assert!(ok.validate().is_ok());
+        // J is bounded by the polar moment Iy + Iz for every section
+        let e = SectionProperties { j: 4e-9, ..ok }.validate().unwrap_err();
+        assert!(
+            e.to_string().contains("`j`") && e.to_string().contains("polar moment"),
+            "{e}"
+        );
+        // a finite shear correction factor is at most 1
+        let e = SectionProperties { ky: 1.2, ..ok }.validate().unwrap_err();
+        assert!(e.to_string().contains("`ky`"), "{e}");
+        // G = E/3 would mean ν = 0.5; G below it, ν > 0.5
+        let e = Material {
+            e: 3.0,
+            g: 0.9,
+            rho: 1.0,
+        }
+        .validate()
+        .unwrap_err();
+        assert!(e.to_string().contains("Poisson"), "{e}");
+        assert!(Material::from_poisson(2.1e11, 0.3, 7800.0)
+            .validate()
+            .is_ok());
     }
 }

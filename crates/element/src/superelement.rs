@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 /// Which interface a deformable-interface mode belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Side {
     /// Boundary node p.
     P,
@@ -17,6 +18,7 @@ pub enum Side {
 
 /// What an extra mode (a column of W in (3.1)) is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum ModeKind {
     /// A warping mode (3.4)–(3.5) of the given interface.
     Warping(Side),
@@ -36,6 +38,7 @@ pub enum ModeKind {
 
 /// Where the superelement data came from.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Provenance {
     /// Source files with their hashes, free text.
     pub sources: Vec<String>,
@@ -50,6 +53,7 @@ pub struct Provenance {
 /// * `modes` describes the η̄ in order: first the p-side interface modes, then the
 ///   q-side ones, then the fixed-interface normal modes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LinearSuperelement {
     /// Reference length |q − p| (m).
     pub l0: f64,

@@ -35,32 +35,83 @@ fn finite_vec(ctx: &str, v: &[f64]) -> Result<(), ModelError> {
 }
 
 fn closest<'a>(id: &str, candidates: impl Iterator<Item = &'a String>) -> String {
-    let mut best: Option<(usize, &str)> = None;
-    for c in candidates {
-        let d = edit_distance(id, c);
-        if best.is_none_or(|(bd, _)| d < bd) {
-            best = Some((d, c));
-        }
-    }
-    match best {
-        Some((d, c)) if d <= 3 => format!(" (did you mean '{c}'?)"),
-        _ => String::new(),
+    match flexmb_input::nearest(id, candidates) {
+        Some(c) => format!(" (did you mean '{c}'?)"),
+        None => String::new(),
     }
 }
 
-fn edit_distance(a: &str, b: &str) -> usize {
-    let a: Vec<char> = a.chars().collect();
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for i in 1..=a.len() {
-        let mut cur = vec![i; b.len() + 1];
-        for j in 1..=b.len() {
-            let c = if a[i - 1] == b[j - 1] { 0 } else { 1 };
-            cur[j] = (prev[j] + 1).min(cur[j - 1] + 1).min(prev[j - 1] + c);
-        }
-        prev = cur;
+/// The material of a scene entry, checked field by field: E > 0, ρ ≥ 0, ν in
+/// (−1, 0.5), G > 0 with the ν it implies in (−1, 0.5), all finite, and G and
+/// ν consistent if both are given. Errors name the material and the field.
+fn material(id: &str, m: &MaterialSpec) -> Result<Material, ModelError> {
+    let bad = |field: &str, v: f64, why: String| {
+        Err(ModelError::invalid(
+            format!("material '{id}'"),
+            format!("{field} = {v}: {why}"),
+        ))
+    };
+    if !(m.e.is_finite() && m.e > 0.0) {
+        return bad(
+            "e (Young's modulus)",
+            m.e,
+            "must be positive and finite".into(),
+        );
     }
-    prev[b.len()]
+    if !(m.rho.is_finite() && m.rho >= 0.0) {
+        return bad(
+            "rho (density)",
+            m.rho,
+            "must be non-negative and finite".into(),
+        );
+    }
+    const NU_RANGE: &str = "(−1, 0.5), the range of an isotropic elastic material";
+    if let Some(nu) = m.nu {
+        if !(nu > -1.0 && nu < 0.5) {
+            return bad(
+                "nu (Poisson's ratio)",
+                nu,
+                format!("must lie in {NU_RANGE}"),
+            );
+        }
+    }
+    let mat = match m.g {
+        Some(g) => {
+            if !(g.is_finite() && g > 0.0) {
+                return bad("g (shear modulus)", g, "must be positive and finite".into());
+            }
+            let implied = m.e / (2.0 * g) - 1.0;
+            if !(implied > -1.0 && implied < 0.5) {
+                return bad(
+                    "g (shear modulus)",
+                    g,
+                    format!(
+                        "implies Poisson's ratio E/(2G) − 1 = {implied:.4}, outside {NU_RANGE} (G must exceed E/3 = {:e})",
+                        m.e / 3.0
+                    ),
+                );
+            }
+            if let Some(nu) = m.nu {
+                let from_nu = m.e / (2.0 * (1.0 + nu));
+                if (from_nu - g).abs() > 1e-6 * g {
+                    return bad(
+                        "g (shear modulus)",
+                        g,
+                        format!("disagrees with nu = {nu}, which gives E/(2(1 + ν)) = {from_nu:e}; give only one of g and nu"),
+                    );
+                }
+            }
+            Material {
+                e: m.e,
+                g,
+                rho: m.rho,
+            }
+        }
+        None => Material::from_poisson(m.e, m.nu.unwrap_or(0.3), m.rho),
+    };
+    mat.validate()
+        .map_err(|e| ModelError::invalid(format!("material '{id}'"), e.to_string()))?;
+    Ok(mat)
 }
 
 /// Assembles a scene. `base_dir` resolves relative superelement file paths.
@@ -123,17 +174,7 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
     // ---- materials and sections
     let mut materials = BTreeMap::new();
     for (id, m) in &scene.materials {
-        let nu = m.nu.unwrap_or(0.3);
-        let mat = match m.g {
-            Some(g) => Material {
-                e: m.e,
-                g,
-                rho: m.rho,
-            },
-            None => Material::from_poisson(m.e, nu, m.rho),
-        };
-        mat.validate()
-            .map_err(|e| ModelError::invalid(format!("material '{id}'"), e.to_string()))?;
+        let mat = material(id, m)?;
         materials.insert(id.clone(), mat);
     }
     let sections: BTreeMap<String, SectionShape> = scene

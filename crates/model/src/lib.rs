@@ -44,17 +44,15 @@ pub use time_function::TimeFunction;
 
 use std::path::Path;
 
-/// Parses RON text, reporting line and column of a syntax error.
+/// Parses RON text, reporting line and column of a syntax error, and for an
+/// unknown field or variant the nearest valid name.
 pub fn parse_ron<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, ModelError> {
-    ron::Options::default()
-        .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
-        .from_str(text)
-        .map_err(|e| ModelError::Parse {
-            file: file.to_string(),
-            line: e.span.start.line,
-            column: e.span.start.col,
-            message: e.code.to_string(),
-        })
+    flexmb_input::from_ron(text).map_err(|e| ModelError::Parse {
+        file: file.to_string(),
+        line: e.line,
+        column: e.column,
+        message: e.message,
+    })
 }
 
 impl Scene {

@@ -8,6 +8,7 @@ use std::collections::BTreeMap;
 
 /// Planar (x, y, φ) or spatial (x, y, z, λ) mechanism.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
 pub enum Dimension {
     /// Planar: nodes have (x, y) and, where an element needs one, an angle φ.
     Planar,
@@ -18,6 +19,7 @@ pub enum Dimension {
 
 /// A material: E, ρ, and either G or Poisson's ratio ν.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
     /// Young's modulus (Pa).
     pub e: f64,
@@ -33,6 +35,7 @@ pub struct MaterialSpec {
 
 /// A cross-section.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum SectionSpec {
     /// Solid rectangle: side `by` along local y, `bz` along local z (m).
     Rectangle {
@@ -62,6 +65,7 @@ pub enum SectionSpec {
 /// A node may share the position coordinates of another node while having its
 /// own orientation (`position_of`): two bodies joined by a hinge at one point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct NodeSpec {
     /// Unique id.
     pub id: String,
@@ -73,6 +77,18 @@ pub struct NodeSpec {
     pub position_of: Option<String>,
 }
 
+fn unique_material_ids<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<BTreeMap<String, MaterialSpec>, D::Error> {
+    flexmb_input::unique_keys_named(d, "material id")
+}
+
+fn unique_section_ids<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<BTreeMap<String, SectionSpec>, D::Error> {
+    flexmb_input::unique_keys_named(d, "section id")
+}
+
 fn default_true() -> bool {
     true
 }
@@ -82,6 +98,7 @@ fn default_one() -> usize {
 
 /// Options of a beam in a scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BeamSpec {
     /// End nodes (p, q).
     pub nodes: (String, String),
@@ -113,6 +130,7 @@ pub struct BeamSpec {
 
 /// What an element is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum ElementSpec {
     /// A beam (planar or spatial after the scene's dimension).
     Beam(BeamSpec),
@@ -184,6 +202,7 @@ pub enum ElementSpec {
 
 /// An element entry.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ElementEntry {
     /// Unique id.
     pub id: String,
@@ -194,6 +213,7 @@ pub struct ElementEntry {
 
 /// A nodal coordinate component.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Component {
     /// x position.
     X,
@@ -213,6 +233,7 @@ pub enum Component {
 
 /// Selects coordinates or deformations in role lists.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Select {
     /// Every coordinate of a node.
     Node(String),
@@ -227,6 +248,7 @@ pub enum Select {
 
 /// A prescribed coordinate or deformation.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Prescribed {
     /// What is prescribed (one coordinate or one deformation).
     pub what: Select,
@@ -236,6 +258,7 @@ pub struct Prescribed {
 
 /// How the degrees of freedom are chosen.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
 pub enum DofChoice {
     /// Deformations where they can describe the motion, then nodal coordinates
     /// (the thesis's choice in chapter 5 and for the FBM of chapter 6).
@@ -249,6 +272,7 @@ pub enum DofChoice {
 
 /// A nodal load: force and/or moment times a function of time.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LoadSpec {
     /// The node.
     pub node: String,
@@ -266,6 +290,7 @@ pub struct LoadSpec {
 /// A PD controller (thesis (7.12)) acting on one coordinate or deformation:
 /// generalized force kp (r − y) + kd (ṙ − ẏ) on it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ControllerSpec {
     /// The controlled coordinate or deformation.
     pub on: Select,
@@ -280,6 +305,7 @@ pub struct ControllerSpec {
 
 /// Outputs to record during a simulation.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum OutputSpec {
     /// Position of a node.
     Position(String),
@@ -297,6 +323,7 @@ pub enum OutputSpec {
 
 /// Initial velocity of a group of nodes moving as a rigid body.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct InitialVelocity {
     /// Nodes this applies to (empty: all non-fixed nodes).
     #[serde(default)]
@@ -314,6 +341,7 @@ pub struct InitialVelocity {
 
 /// A complete scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Scene {
     /// A descriptive name.
     #[serde(default)]
@@ -324,11 +352,11 @@ pub struct Scene {
     /// Gravity acceleration vector (m/s²), if any.
     #[serde(default)]
     pub gravity: Option<Vec<f64>>,
-    /// Materials by id.
-    #[serde(default)]
+    /// Materials by id (each id once).
+    #[serde(default, deserialize_with = "unique_material_ids")]
     pub materials: BTreeMap<String, MaterialSpec>,
-    /// Sections by id.
-    #[serde(default)]
+    /// Sections by id (each id once).
+    #[serde(default, deserialize_with = "unique_section_ids")]
     pub sections: BTreeMap<String, SectionSpec>,
     /// Nodes.
     pub nodes: Vec<NodeSpec>,

@@ -7,6 +7,7 @@ use std::f64::consts::PI;
 
 /// A scalar function of time with exact first and second derivatives.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum TimeFunction {
     /// A constant value.
     Constant(f64),

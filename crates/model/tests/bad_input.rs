@@ -183,3 +183,209 @@ fn malformed_ron_reports_line_and_column() {
     }
     assert!(e.to_string().contains("line 3, column"), "{e}");
 }
+
+/// A parse error: (line, column, message).
+fn parse_err(text: &str) -> (usize, usize, String) {
+    match Scene::from_ron_str(text) {
+        Ok(_) => panic!("expected a parse error"),
+        Err(e) => match &e {
+            ModelError::Parse { line, column, .. } => (*line, *column, e.to_string()),
+            other => panic!("expected a parse error, got {other}"),
+        },
+    }
+}
+
+/// Issue 14.1: a misspelt field used to be ignored (`gravityy` dropped
+/// gravity, `timoshenkoo` kept Timoshenko bending, `fixd` gave a free-free
+/// model). Each is an error with line, column and the nearest valid name, at
+/// every level: the scene, a struct inside a newtype variant (`BeamSpec`), a
+/// struct variant of an enum (`Truss`, `Ramp`), a struct in a tuple variant
+/// (`User` section) and a map value (a material).
+#[test]
+fn unknown_fields_are_rejected_with_line_column_and_the_nearest_name() {
+    let (line, column, e) = parse_err(&variant(
+        "    fixed: [ Node(\"A\") ],",
+        "    gravityy: Some([0.0, -9.81]),\n    fixed: [ Node(\"A\") ],",
+    ));
+    assert_eq!((line, column), (10, 5), "{e}");
+    assert!(
+        e.contains("`gravityy`") && e.contains("did you mean `gravity`?"),
+        "{e}"
+    );
+    let (line, _, e) = parse_err(&variant("fixed: [", "fixd: ["));
+    assert_eq!(line, 10, "{e}");
+    assert!(e.contains("did you mean `fixed`?"), "{e}");
+    let (line, _, e) = parse_err(&variant(
+        r#"section: "bar"))),
+        (id: "bc""#,
+        r#"section: "bar", timoshenkoo: false))),
+        (id: "bc""#,
+    ));
+    assert_eq!(line, 7, "{e}");
+    assert!(e.contains("did you mean `timoshenko`?"), "{e}");
+    let (_, _, e) = parse_err(&variant("(e: 7.0e10,", "(e: 7.0e10, nuu: 0.33,"));
+    assert!(e.contains("did you mean `nu`?"), "{e}");
+    let (_, _, e) = parse_err(&variant(
+        "Rectangle(by: 0.01, bz: 0.02)",
+        "User((area: 2e-4, iy: 6.7e-9, iz: 1.7e-9, j: 4.6e-9, ky: 0.85, kz: 0.85, kzz: 1.0))",
+    ));
+    assert!(
+        e.contains("`kzz`") && e.contains("did you mean `kz`?"),
+        "{e}"
+    );
+    let (_, _, e) = parse_err(&variant(
+        r#"(id: "bc", type: Beam((nodes: ("B", "C"), material: "al", section: "bar"))),"#,
+        r#"(id: "bc", type: Truss(nodes: ("B", "C"), ea: 1e6, mass_per_lenght: 1.0)),"#,
+    ));
+    assert!(e.contains("did you mean `mass_per_length`?"), "{e}");
+    let (_, _, e) = parse_err(&variant(
+        "    fixed: [ Node(\"A\") ],",
+        "    fixed: [ Node(\"A\") ],\n    prescribed: [ (what: Coord(\"B\", Y), function: Ramp(t0: 0.0, t1: 1.0, v0: 0.0, v: 1.0)) ],",
+    ));
+    assert!(e.contains("`v`") && e.contains("in `Ramp`"), "{e}");
+    // a misspelt variant gets a suggestion too
+    let (_, _, e) = parse_err(&variant("Rectangle(", "Rectangel("));
+    assert!(e.contains("did you mean `Rectangle`?"), "{e}");
+}
+
+/// Issue 14.1: a repeated material or section id used to keep the last entry
+/// silently; it is an error naming the id, with its line.
+#[test]
+fn duplicate_material_and_section_ids_are_rejected() {
+    let (line, _, e) = parse_err(&variant(
+        r#"materials: { "al": (e: 7.0e10, rho: 2700.0) },"#,
+        "materials: {\n        \"al\": (e: 7.0e10, rho: 2700.0),\n        \"al\": (e: 7.0e7, rho: 2700.0),\n    },",
+    ));
+    assert_eq!(line, 5, "{e}");
+    assert!(e.contains("duplicate material id 'al'"), "{e}");
+    let (_, _, e) = parse_err(&variant(
+        r#"sections: { "bar": Rectangle(by: 0.01, bz: 0.02) },"#,
+        r#"sections: { "bar": Rectangle(by: 0.01, bz: 0.02), "bar": Circle(d: 0.1) },"#,
+    ));
+    assert!(e.contains("duplicate section id 'bar'"), "{e}");
+}
+
+/// Issue 13.8: material data must be physical. ν = 2 used to be accepted.
+/// Each error names the material and the field.
+#[test]
+fn unphysical_materials_are_rejected_naming_the_material_and_field() {
+    let with = |m: &str| err(&variant("(e: 7.0e10, rho: 2700.0)", m));
+    for (m, field) in [
+        (
+            "(e: 7.0e10, nu: 2.0, rho: 2700.0)",
+            "nu (Poisson's ratio) = 2",
+        ),
+        (
+            "(e: 7.0e10, nu: 0.5, rho: 2700.0)",
+            "nu (Poisson's ratio) = 0.5",
+        ),
+        (
+            "(e: 7.0e10, nu: -1.0, rho: 2700.0)",
+            "nu (Poisson's ratio) = -1",
+        ),
+        (
+            "(e: 7.0e10, nu: NaN, rho: 2700.0)",
+            "nu (Poisson's ratio) = NaN",
+        ),
+        ("(e: 0.0, rho: 2700.0)", "e (Young's modulus) = 0"),
+        ("(e: inf, rho: 2700.0)", "e (Young's modulus) = inf"),
+        ("(e: 7.0e10, rho: -1.0)", "rho (density) = -1"),
+        ("(e: 7.0e10, g: 0.0, rho: 2700.0)", "g (shear modulus) = 0"),
+        // G below E/3 means ν > 0.5
+        (
+            "(e: 7.0e10, g: 2.0e10, rho: 2700.0)",
+            "implies Poisson's ratio",
+        ),
+        // both given and inconsistent
+        (
+            "(e: 7.0e10, g: 2.6e10, nu: 0.2, rho: 2700.0)",
+            "disagrees with nu",
+        ),
+    ] {
+        let e = with(m);
+        assert!(e.contains("material 'al'") && e.contains(field), "{m}: {e}");
+    }
+    // consistent G and ν together are fine
+    let ok = variant(
+        "(e: 7.0e10, rho: 2700.0)",
+        "(e: 7.0e10, g: 2.5e10, nu: 0.4, rho: 2700.0)",
+    );
+    Scene::from_ron_str(&ok).unwrap().build(None).unwrap();
+}
+
+/// Issue 13.8: sections must be physical: positive finite dimensions, a tube
+/// wall between zero and half the outer diameter, positive properties of a
+/// `User` section with J ≤ Iy + Iz and shear factors in (0, 1] or inf.
+#[test]
+fn unphysical_sections_are_rejected_naming_the_section_and_field() {
+    let with = |s: &str| err(&variant("Rectangle(by: 0.01, bz: 0.02)", s));
+    for (s, field) in [
+        ("Rectangle(by: -0.01, bz: 0.02)", "`by`"),
+        ("Rectangle(by: 0.01, bz: inf)", "`bz`"),
+        ("Circle(d: 0.0)", "`d`"),
+        ("Tube(d_outer: 0.02, d_inner: 0.02)", "`d_inner`"),
+        ("Tube(d_outer: 0.02, d_inner: -0.001)", "`d_inner`"),
+        (
+            "User((area: 0.0, iy: 1e-9, iz: 1e-9, j: 1e-9, ky: inf, kz: inf))",
+            "`area`",
+        ),
+        (
+            "User((area: 2e-4, iy: 1e-9, iz: 1e-9, j: 5e-9, ky: inf, kz: inf))",
+            "`j`",
+        ),
+        (
+            "User((area: 2e-4, iy: 1e-9, iz: 1e-9, j: 1e-9, ky: 0.0, kz: inf))",
+            "`ky`",
+        ),
+        (
+            "User((area: 2e-4, iy: 1e-9, iz: 1e-9, j: 1e-9, ky: inf, kz: 1.5))",
+            "`kz`",
+        ),
+    ] {
+        let e = with(s);
+        assert!(e.contains("section 'bar'") && e.contains(field), "{s}: {e}");
+    }
+}
+
+/// Issue 14.1: a superelement file with an unknown field is rejected when a
+/// scene loads it, naming the file, line and field.
+#[test]
+fn superelement_files_with_unknown_fields_are_rejected() {
+    use flexmb_element::LinearSuperelement;
+    let dir = std::env::temp_dir().join(format!("flexmb-bad-se-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut s = nalgebra::DMatrix::<f64>::identity(6, 6);
+    s *= 1.0e6;
+    let m = nalgebra::DMatrix::<f64>::identity(12, 12);
+    let eye = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let se = LinearSuperelement::from_matrices(1.0, eye, &s, &m, vec![]);
+    let text = ron::ser::to_string_pretty(&se, ron::ser::PrettyConfig::default()).unwrap();
+    let scene = |file: &str| {
+        format!(
+            r#"(
+    materials: {{}},
+    nodes: [ (id: "P", at: [0.0, 0.0, 0.0]), (id: "Q", at: [1.0, 0.0, 0.0]) ],
+    elements: [ (id: "se", type: Superelement(nodes: ("P", "Q"), file: "{file}")) ],
+    fixed: [ Node("P") ],
+)"#
+        )
+    };
+    std::fs::write(dir.join("good.se.ron"), &text).unwrap();
+    Scene::from_ron_str(&scene("good.se.ron"))
+        .unwrap()
+        .build(Some(&dir))
+        .unwrap();
+    let bad = text.replacen("modes:", "mode: [],\n    modes:", 1);
+    assert_ne!(bad, text);
+    std::fs::write(dir.join("bad.se.ron"), &bad).unwrap();
+    let e = Scene::from_ron_str(&scene("bad.se.ron"))
+        .unwrap()
+        .build(Some(&dir))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("bad.se.ron") && e.contains("`mode`") && e.contains("did you mean `modes`?"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -34,3 +34,21 @@ fn planar_straight_guidance_has_17_dofs() {
     let m = scene("straight_guidance_planar.ron").build(None).unwrap();
     assert_eq!(m.n_dof(), 17, "{}", m.summary());
 }
+
+/// Every scene in fixtures/scenes parses under the strict reader (unknown
+/// fields and repeated map keys rejected) and assembles.
+#[test]
+fn every_fixture_scene_parses_strictly_and_builds() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenes");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.extension().is_some_and(|e| e == "ron") {
+            let s = Scene::load(&p).unwrap_or_else(|e| panic!("{e}"));
+            s.build(p.parent())
+                .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+            n += 1;
+        }
+    }
+    assert!(n >= 9, "{n} scenes");
+}

@@ -15,6 +15,7 @@ pub const FORMAT_VERSION: u32 = 1;
 
 /// A reduced model on disk.
 #[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SavedModel {
     /// File format version ([`FORMAT_VERSION`]).
     pub format: u32,
@@ -30,6 +31,7 @@ pub struct SavedModel {
 
 /// The data of a basis.
 #[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum SavedBasis {
     /// G = q0 + Vη (6.16).
     Fixed {
@@ -110,13 +112,13 @@ impl SavedModel {
     pub fn load(path: &Path) -> Result<Self, ReductionError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| ReductionError::Invalid(format!("cannot read {}: {e}", path.display())))?;
-        let m: Self = ron::from_str(&text).map_err(|e| {
+        let m: Self = flexmb_input::from_ron(&text).map_err(|e| {
             ReductionError::Invalid(format!(
                 "{}:{}:{}: not a reduced model: {}",
                 path.display(),
-                e.span.start.line,
-                e.span.start.col,
-                e.code
+                e.line,
+                e.column,
+                e.message
             ))
         })?;
         if m.format != FORMAT_VERSION {

@@ -119,3 +119,21 @@ fn a_damaged_file_is_refused_with_its_position() {
         "{e}"
     );
 }
+
+/// Issue 14.1: a misspelt field of a saved model (here of a basis variant)
+/// used to be ignored; it is refused with its position and the nearest name.
+#[test]
+fn a_misspelt_field_is_refused_with_the_nearest_name() {
+    let path = temp("typo.ron");
+    std::fs::write(
+        &path,
+        "(format: 1, description: \"x\", scene: \"s\", dofs: [],\n basis: Fixed(q0: [], vector: []))",
+    )
+    .unwrap();
+    let e = SavedModel::load(&path).unwrap_err().to_string();
+    std::fs::remove_file(&path).ok();
+    assert!(
+        e.contains(":2:") && e.contains("`vector`") && e.contains("did you mean `vectors`?"),
+        "{e}"
+    );
+}

@@ -31,6 +31,7 @@ use std::time::Instant;
 /// A displacement pattern of interface nodes, in global coordinates: the node
 /// at `points[i]` moves by `displacements[i]`. Nodes are matched by position.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct InterfacePattern {
     /// Node positions (m).
     pub points: Vec<[f64; 3]>,
@@ -43,6 +44,7 @@ pub struct InterfacePattern {
 
 /// A deformable-interface mode from a prescribed pattern.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct InterfaceMode {
     /// The interface it deforms.
     pub side: Side,
@@ -62,6 +64,7 @@ pub struct InterfaceMode {
 ///
 /// A zero mass gives a pure rigid link (e.g. to tie parts of a mesh).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PointMass {
     /// A name for messages.
     pub name: String,
@@ -82,6 +85,7 @@ fn default_density_range() -> Option<[f64; 2]> {
 
 /// What to build.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BuildSettings {
     /// Boundary node p (m) (global); the element frame's origin.
     pub p: [f64; 3],
@@ -142,6 +146,7 @@ impl BuildSettings {
 
 /// Figures of a build.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BuildReport {
     /// FE equations.
     pub n_eq: usize,
@@ -1352,6 +1357,7 @@ pub fn fixed_interface_eigenvalues_sparse(
 
 /// A rigid motion: translation plus a small rotation about a point.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RigidMotion {
     /// Translation (m).
     pub translation: [f64; 3],

@@ -369,6 +369,7 @@ pub(crate) fn sym_quad(a: SparseColMatRef<'_, usize, f64>, u: &[f64], v: &[f64])
 
 /// A set of nodes chosen by label or by geometry.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum NodeSelection {
     /// Nodes by label.
     Ids(Vec<u64>),

@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 
 /// Where the FE model comes from. Paths are relative to the spec's directory.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum ModelSource {
     /// CalculiX exports `JOB.sti`, `JOB.mas`, `JOB.dof` and the mesh `inp`
     /// (default `JOB.inp`).
@@ -59,6 +60,7 @@ pub enum ModelSource {
 
 /// A build specification.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Spec {
     /// A name for the part.
     pub name: String,
@@ -76,7 +78,8 @@ pub struct Spec {
 impl Spec {
     /// Parses a RON spec.
     pub fn from_ron(text: &str, file: &str) -> Result<Self, Error> {
-        ron::from_str(text).map_err(|e| Error::parse(file, e.span.start.line, e.code.to_string()))
+        flexmb_input::from_ron(text)
+            .map_err(|e| Error::parse(file, e.line, format!("column {}: {}", e.column, e.message)))
     }
     /// Reads a RON spec file.
     pub fn read(path: &Path) -> Result<Self, Error> {
@@ -160,11 +163,11 @@ pub fn write_ron(path: &Path, data: &LinearSuperelement) -> Result<(), Error> {
 /// Reads superelement data from RON.
 pub fn read_ron(path: &Path) -> Result<LinearSuperelement, Error> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    ron::from_str(&text).map_err(|e| {
+    flexmb_input::from_ron(&text).map_err(|e| {
         Error::parse(
             &path.display().to_string(),
-            e.span.start.line,
-            e.code.to_string(),
+            e.line,
+            format!("column {}: {}", e.column, e.message),
         )
     })
 }

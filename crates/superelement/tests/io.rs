@@ -491,3 +491,54 @@ fn inp_includes_and_gmsh_layout() {
         &["short.inp:4", "continues past the block"],
     );
 }
+
+/// Issue 14.1: a misspelt field in a spec (`normal_mode: 6` used to build 0
+/// normal modes) or in a superelement file is refused with its line, column
+/// and the nearest valid name; so is a misspelt field of a struct variant.
+#[test]
+fn misspelt_fields_in_specs_and_superelement_files_are_refused() {
+    let (model, settings) = small_bar();
+    let spec = Spec {
+        name: "small".into(),
+        model: ModelSource::CalculiX {
+            job: "job".into(),
+            inp: None,
+        },
+        settings: BuildSettings {
+            normal_modes: 6,
+            ..settings.clone()
+        },
+        output: "small.se.ron".into(),
+        m_bar_matrix_market: None,
+    };
+    let text = ron::ser::to_string_pretty(&spec, Default::default()).unwrap();
+    assert_eq!(Spec::from_ron(&text, "spec.ron").unwrap(), spec);
+    let line_of = |t: &str, what: &str| t.lines().position(|l| l.contains(what)).unwrap() + 1;
+    let bad = text.replacen("normal_modes:", "normal_mode:", 1);
+    let e = expect_err(
+        Spec::from_ron(&bad, "spec.ron"),
+        &["`normal_mode`", "did you mean `normal_modes`?"],
+    );
+    assert!(
+        e.starts_with(&format!(
+            "spec.ron:{}: column ",
+            line_of(&bad, "normal_mode:")
+        )),
+        "{e}"
+    );
+    let bad = text.replacen("job:", "jbo:", 1);
+    expect_err(Spec::from_ron(&bad, "spec.ron"), &["did you mean `job`?"]);
+    // a superelement file
+    let dir = tmp("typo");
+    let data = build(&model, &settings).unwrap().data;
+    let p = dir.join("small.se.ron");
+    flexmb_superelement::spec::write_ron(&p, &data).unwrap();
+    assert_eq!(read_ron(&p).unwrap(), data);
+    let text = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(&p, text.replacen("m_bar:", "mbar:", 1)).unwrap();
+    expect_err(
+        read_ron(&p),
+        &["small.se.ron:", "`mbar`", "did you mean `m_bar`?"],
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
