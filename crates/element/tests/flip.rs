@@ -15,9 +15,12 @@ use std::f64::consts::PI;
 /// Angles of the node turn, below and above the flip angle π/2.
 const TURNS: [f64; 6] = [0.0, 0.3, 1.5, 1.65, 2.5, PI];
 
-/// Spatial chord elements in their reference configuration (rp, λp, rq, λq,
-/// modes) with the frame R0 they were built with.
-fn spatial_cases() -> Vec<(String, Element, Vec<f64>, [[f64; 3]; 3])> {
+/// A spatial chord element: name, element, its reference configuration
+/// (rp, λp, rq, λq, modes) and the frame R0 it was built with.
+type Case = (String, Element, Vec<f64>, [[f64; 3]; 3]);
+
+/// The spatial chord elements under test.
+fn spatial_cases() -> Vec<Case> {
     let mut rng = rng(7);
     let mut v = vec![];
     let (p, q, up) = ([0.1, 0.2, -0.1], [0.3, 0.1, 0.05], [0.0, 0.0, 1.0]);

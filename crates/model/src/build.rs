@@ -686,7 +686,7 @@ fn check_reference_configuration(
         let strained = eps
             .iter()
             .enumerate()
-            .filter(|(_, v)| !(v.abs() <= tol))
+            .filter(|(_, v)| v.abs() > tol || v.is_nan())
             .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
         let what = match (strained, e.element.is_flipped(&xl)) {
             (Some((i, v)), _) => format!(
