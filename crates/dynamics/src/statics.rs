@@ -284,6 +284,13 @@ impl Dynamics {
 
     /// Static equilibrium at time `t` (inputs at their values at t), starting
     /// from `q0`, with load increments and held degrees of freedom.
+    ///
+    /// Stays on the physical branch: an iterate at which an element has
+    /// flipped ([`flexmb_element::Element::is_flipped`]: its chord turned by
+    /// more than π/2 against a node frame, where the periodic deformations
+    /// (5.3b,c), (6.2b), (3.14b) fold back) has its Newton update halved, up
+    /// to 10 times, then the load increment is cut; an
+    /// equilibrium with a flipped element is [`DynamicsError::Flipped`].
     pub fn static_equilibrium(
         &mut self,
         t: f64,
