@@ -103,6 +103,18 @@ pub enum DynamicsError {
         /// The last failure.
         cause: String,
     },
+    /// An element has flipped: its chord is turned by more than π/2 against
+    /// one of its node frames ([`flexmb_element::Element::is_flipped`]), a
+    /// spurious branch of its periodic deformation functions.
+    #[error("element '{element}' has flipped at load factor {load_factor}: its chord is turned by {angle_deg:.1}° against its node frames (more than 90°), a state that satisfies the periodic deformation functions but is no deformation of the element; use more elements where the rotation is large, or more load steps")]
+    Flipped {
+        /// The element id.
+        element: String,
+        /// The angle between its chord and a node frame's x axis (degrees).
+        angle_deg: f64,
+        /// The load factor of the iterate.
+        load_factor: f64,
+    },
     /// Invalid argument.
     #[error("{0}")]
     Invalid(String),

@@ -46,6 +46,10 @@ impl Default for StaticOptions {
 /// factor; otherwise the tangent is rebuilt at the current iterate.
 const CHORD_CONTRACTION: f64 = 0.2;
 
+/// Halvings of a Newton update whose iterate flips an element before the
+/// load increment is cut instead.
+const MAX_FLIP_HALVINGS: usize = 10;
+
 /// The factorized static tangent kept between Newton iterations (and between
 /// calls, e.g. along a sweep) for chord steps.
 pub(crate) struct StaticFactor {
@@ -280,6 +284,13 @@ impl Dynamics {
 
     /// Static equilibrium at time `t` (inputs at their values at t), starting
     /// from `q0`, with load increments and held degrees of freedom.
+    ///
+    /// Stays on the physical branch: an iterate at which an element has
+    /// flipped ([`flexmb_element::Element::is_flipped`]: its chord turned by
+    /// more than π/2 against a node frame, where the periodic deformations
+    /// (5.3b,c), (6.2b), (3.14b) fold back) has its Newton update halved, up
+    /// to 10 times, then the load increment is cut; an
+    /// equilibrium with a flipped element is [`DynamicsError::Flipped`].
     pub fn static_equilibrium(
         &mut self,
         t: f64,
@@ -306,6 +317,13 @@ impl Dynamics {
         let mut last_good = q.clone();
         let mut last_err = None;
         let mut force_refresh = false;
+        // the branch guard: the last update (to halve if its iterate flips an
+        // element) and the configurations of the last unflipped iterate and of
+        // the last converged increment (guesses for the kinematics after a
+        // rejected iterate or increment)
+        let mut dq_last = vec![0.0; free.len()];
+        let mut x_ok = self.mech.x0.clone();
+        let mut x_good = x_ok.clone();
         while lambda < 1.0 - 1e-15 {
             let target = (lambda + dl).min(1.0);
             self.load_factor = if opts.ramp_loads { target } else { 1.0 };
@@ -315,6 +333,7 @@ impl Dynamics {
             let mut converged = false;
             let mut prev_dn = f64::INFINITY;
             let mut steps = 0;
+            let mut halvings = 0;
             while steps < opts.max_iterations {
                 iterations += 1;
                 // chord Newton: keep the factorized tangent (of an earlier
@@ -336,6 +355,33 @@ impl Dynamics {
                     }
                 };
                 force_refresh = false;
+                // an iterate that flips an element is on a spurious branch of
+                // the periodic deformation functions: halve the update that
+                // led there (with a tangent and a kinematic guess from before
+                // it), or cut the increment
+                if let Some((e, angle)) = self.mech.flipped_element(self.kin.x()) {
+                    if steps == 0 || halvings == MAX_FLIP_HALVINGS {
+                        last_err = Some(DynamicsError::Flipped {
+                            element: e.id.clone(),
+                            angle_deg: angle.to_degrees(),
+                            load_factor: target,
+                        });
+                        break;
+                    }
+                    halvings += 1;
+                    for (k, i) in free.iter().enumerate() {
+                        dq_last[k] *= 0.5;
+                        q[*i] -= dq_last[k];
+                    }
+                    self.kin.set_guess(&x_ok);
+                    force_refresh = true;
+                    continue;
+                }
+                halvings = 0;
+                x_ok.copy_from_slice(self.kin.x());
+                if increments == 0 && steps == 0 {
+                    x_good.copy_from_slice(&x_ok);
+                }
                 let Some(factor) = &self.static_factor else {
                     break;
                 };
@@ -356,6 +402,7 @@ impl Dynamics {
                 for (k, i) in free.iter().enumerate() {
                     q[*i] += dq[k];
                 }
+                dq_last.copy_from_slice(&dq);
                 if dn <= opts.tol * (1.0 + qn) {
                     converged = true;
                     break;
@@ -366,12 +413,13 @@ impl Dynamics {
                 lambda = target;
                 increments += 1;
                 last_good.copy_from_slice(&q);
+                x_good.copy_from_slice(&x_ok);
                 dl = (dl * 2.0).min(1.0);
             } else {
                 // retry a smaller increment with a tangent at its start
                 force_refresh = true;
                 q.copy_from_slice(&last_good);
-                self.kin.set_guess(&self.mech.x0.clone());
+                self.kin.set_guess(&x_good);
                 let _ = self.kin.solve(&q, t);
                 dl *= 0.5;
                 if dl < opts.min_increment {
@@ -387,6 +435,13 @@ impl Dynamics {
         }
         self.load_factor = 1.0;
         let g = self.static_residual(t, &q)?;
+        if let Some((e, angle)) = self.mech.flipped_element(self.kin.x()) {
+            return Err(DynamicsError::Flipped {
+                element: e.id.clone(),
+                angle_deg: angle.to_degrees(),
+                load_factor: 1.0,
+            });
+        }
         let reactions = opts.held.iter().map(|(i, _)| g[*i]).collect();
         Ok(StaticSolution {
             q,

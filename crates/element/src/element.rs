@@ -638,7 +638,61 @@ impl Element {
     }
 }
 
+/// The largest angle between an element's chord and the local x axis of one
+/// of its node frames that the deformation functions can tell apart: π/2.
+///
+/// The bending deformations of the beams and superelements are l0 × the sine
+/// of that angle ((5.3b,c), (6.2b), (3.14b)): beyond π/2 they fold back, and a
+/// chord reversed against both frames (angle π) has zero bending and zero
+/// elongation, an undeformed-looking state that satisfies every equation. An
+/// element beyond this angle has flipped (see [`Element::is_flipped`]).
+pub const FLIP_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
+
 impl Element {
+    /// The cosines of the angles between the element's chord p → q and the
+    /// local x axes of its p and q node frames at x, for the elements whose
+    /// deformations are periodic in them (planar and spatial beams,
+    /// superelements); `None` for the others (trusses have no frames, hinge
+    /// angles are unwrapped over turns, masses have no deformations).
+    pub fn chord_cosines(&self, x: &[f64]) -> Option<[f64; 2]> {
+        match &self.kind {
+            Kind::PlanarBeam(k, _) => Some(k.chord_cosines(x)),
+            Kind::TwoNode { kernel, .. } => Some(kernel.chord_cosines(x)),
+            _ => None,
+        }
+    }
+
+    /// The larger of the two angles (rad, in \[0, π\]) between the chord and
+    /// the node frames' x axes of [`chord_cosines`](Self::chord_cosines).
+    pub fn chord_angle(&self, x: &[f64]) -> Option<f64> {
+        self.chord_cosines(x)
+            .map(|[a, b]| a.min(b).clamp(-1.0, 1.0).acos())
+    }
+
+    /// Whether the element has flipped at x: its chord turned by more than
+    /// [`FLIP_ANGLE`] = π/2 against one of its node frames (a non-finite
+    /// chord counts as flipped). Such a configuration is on a spurious branch
+    /// of the periodic deformation functions, not a physical deformation of
+    /// the element. Cheap (no trigonometry for spatial elements, two cosines
+    /// for planar ones), for a check per Newton iterate.
+    pub fn is_flipped(&self, x: &[f64]) -> bool {
+        self.chord_cosines(x)
+            .is_some_and(|[a, b]| !(a > 0.0 && b > 0.0))
+    }
+
+    /// The length that the element's deformations are measured in: l0 for
+    /// beams, trusses and superelements (elongation, and bending as
+    /// l0 × an angle, (5.3), (6.2b)); `None` for elements whose deformations
+    /// are angles (hinges) or dimensionless (the normalization).
+    pub fn reference_length(&self) -> Option<f64> {
+        match &self.kind {
+            Kind::PlanarBeam(k, _) => Some(k.l0),
+            Kind::TwoNode { kernel, .. } => Some(kernel.l0),
+            Kind::PlanarTruss { l0, .. } | Kind::Truss { l0, .. } => Some(*l0),
+            _ => None,
+        }
+    }
+
     fn mode_count(&self) -> usize {
         match &self.kind {
             Kind::TwoNode { modes, .. } => *modes,

@@ -123,6 +123,21 @@ impl DefKernel<14, 6> for TwoNodeSpatial {
     }
 }
 
+impl TwoNodeSpatial {
+    /// The cosines of the angles between the chord rq − rp and the local x axes
+    /// Rp R0 e_x, Rq R0 e_x of the two node frames (primal values only). The
+    /// bending deformations (6.2b) are l0 × the sines of such angles, hence
+    /// periodic in them: a chord reversed against both frames gives ε = 0.
+    pub fn chord_cosines(&self, x: &[f64]) -> [f64; 2] {
+        let d = vec3(x, 7) - vec3(x, 0);
+        let along = |i: usize| {
+            let e = triad_axis(&rotation(&quat(x, i)), &self.r0, 0);
+            d.dot(&e) / (d.norm() * e.norm())
+        };
+        [along(3), along(10)]
+    }
+}
+
 /// The planar beam of thesis (5.3) on x = (xp, yp, φp, xq, yq, φq):
 /// ε1 = l − l0 + (2ε2² + ε2ε3 + 2ε3²)/(30 l0) (the shortening term optional),
 /// ε2 = (l0/l)(Δx sin(φp+β0) − Δy cos(φp+β0)), ε3 = −(l0/l)(Δx sin(φq+β0) − Δy cos(φq+β0)).
@@ -148,6 +163,22 @@ impl DefKernel<6, 3> for PlanarBeamKernel {
             e1 += ((e2 * e2 + e3 * e3) * 2.0 + e2 * e3) * (1.0 / (30.0 * self.l0));
         }
         [e1, e2, e3]
+    }
+}
+
+impl PlanarBeamKernel {
+    /// The cosines of the angles between the chord and the local x axes
+    /// (cos(φ + β0), sin(φ + β0)) of the two node frames: (5.3b,c) are
+    /// ε2 = l0 sin(φp + β0 − γ), ε3 = −l0 sin(φq + β0 − γ) with γ the chord's
+    /// angle, periodic in the angle between chord and frame.
+    pub fn chord_cosines(&self, x: &[f64]) -> [f64; 2] {
+        let (dx, dy) = (x[3] - x[0], x[4] - x[1]);
+        let l = (dx * dx + dy * dy).sqrt();
+        let along = |phi: f64| {
+            let a = phi + self.beta0;
+            (dx * a.cos() + dy * a.sin()) / l
+        };
+        [along(x[2]), along(x[5])]
     }
 }
 

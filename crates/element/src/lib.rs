@@ -45,7 +45,7 @@ pub use beam_matrices::{
     equivalent_stiffness, planar_beam_m_bar, planar_beam_s_bar, shear_parameter, spatial_a_diag,
     spatial_beam_m_bar, spatial_beam_s_bar,
 };
-pub use element::{frame_from_axis, BeamOptions, Element, Slot};
+pub use element::{frame_from_axis, BeamOptions, Element, Slot, FLIP_ANGLE};
 pub use inertia::{VelocityTransform, MAX_MODES};
 pub use section::{rectangle_torsion_constant, Material, SectionProperties, SectionShape};
 pub use superelement::{LinearSuperelement, ModeKind, Provenance, Side};

@@ -227,6 +227,7 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
     let mut expanded: Vec<Expanded> = vec![];
     let mut element_ids = HashMap::new();
     let mut mode_groups: Vec<(String, usize)> = vec![];
+    let mut part_axes: HashMap<String, PartAxis> = HashMap::new();
     for entry in &scene.elements {
         let id = entry.id.clone();
         if element_ids.insert(id.clone(), ()).is_some() {
@@ -488,6 +489,15 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
                     ));
                 }
                 let element = Element::superelement(&data, *transform).map_err(wrap)?;
+                part_axes.insert(
+                    id.clone(),
+                    PartAxis {
+                        p: (nodes.0.clone(), [p[0], p[1], p[2]]),
+                        q: (nodes.1.clone(), [q[0], q[1], q[2]]),
+                        l0: data.l0,
+                        x: std::array::from_fn(|i| data.r0[i][0]),
+                    },
+                );
                 let (kp, kq, kf) = data.mode_counts();
                 let gp = share.0.clone().unwrap_or_else(|| format!("{id}.p"));
                 let gq = share.1.clone().unwrap_or_else(|| format!("{id}.q"));
@@ -669,9 +679,87 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
         outputs: scene.outputs.clone(),
         initial_xd: vec![0.0; n_x],
     };
+    check_reference_configuration(&mech, &part_axes)?;
     crate::roles::assign(scene, &mut mech)?;
     crate::loads::assign(scene, &mut mech)?;
     Ok(mech)
+}
+
+/// Where a superelement's FE part has its p → q axis: the first column of R0.
+struct PartAxis {
+    /// Scene node p and its position.
+    p: (String, [f64; 3]),
+    /// Scene node q and its position.
+    q: (String, [f64; 3]),
+    /// The part's l0.
+    l0: f64,
+    /// The part's p → q direction (global, as built).
+    x: [f64; 3],
+}
+
+/// Relative tolerance of the reference-strain check: |ε| ≤ 1e-9 l0 for the
+/// deformations of beams, trusses and superelements (lengths, or l0 × an
+/// angle), |ε| ≤ 1e-9 rad for hinge angles.
+const REFERENCE_STRAIN_TOL: f64 = 1e-9;
+
+/// Every element must be undeformed at the reference configuration x0: the
+/// initial deformations ε = D(x0) (thesis (5.7) at the reference) are zero and
+/// no element has flipped (a chord reversed against its node frames has ε = 0
+/// too, [`Element::is_flipped`]). Scenes have no initial stress or prestrain,
+/// so an element deformed at x0 would start strained and move the mechanism
+/// without any load. Superelements are where this happens: their R0 is the FE
+/// part's, and the scene's nodes may point elsewhere.
+fn check_reference_configuration(
+    mech: &Mechanism,
+    part_axes: &HashMap<String, PartAxis>,
+) -> Result<(), ModelError> {
+    let mut xl = vec![];
+    let mut eps = vec![];
+    for e in &mech.elements {
+        xl.resize(e.x_index.len(), 0.0);
+        e.gather(&mech.x0, &mut xl);
+        eps.resize(e.element.n_eps(), 0.0);
+        e.element.deformations(&xl, None, &mut eps);
+        let (tol, unit) = match e.element.reference_length() {
+            Some(l0) => (REFERENCE_STRAIN_TOL * l0, "m"),
+            None => (REFERENCE_STRAIN_TOL, "rad"),
+        };
+        let strained = eps
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.abs() > tol || v.is_nan())
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
+        let what = match (strained, e.element.is_flipped(&xl)) {
+            (Some((i, v)), _) => format!(
+                "is deformed at the node positions of the scene ({} = {v:.3e} {unit}, tolerance {tol:.1e} {unit})",
+                e.element.deformation_names()[i]
+            ),
+            (None, true) => format!(
+                "is reversed at the node positions of the scene (its chord is turned by {:.1}° against its node frames)",
+                e.element.chord_angle(&xl).unwrap_or(f64::NAN).to_degrees()
+            ),
+            (None, false) => continue,
+        };
+        let fix = match part_axes.get(&e.id) {
+            Some(a) => {
+                // rounding-level components printed as 0
+                let snap = |v: [f64; 3], scale: f64| v.map(|c| if c.abs() <= 1e-12 * scale { 0.0 } else { c });
+                let q: [f64; 3] = std::array::from_fn(|i| a.p.1[i] + a.l0 * a.x[i]);
+                let scale = a.l0.max(a.p.1.iter().fold(0.0, |m: f64, c| m.max(c.abs())));
+                let d: [f64; 3] = std::array::from_fn(|i| (a.q.1[i] - a.p.1[i]) / a.l0);
+                format!(
+                    "the scene's '{}' → '{}' points along {:?}, the FE part's p → q along {:?} (R0 of the superelement file). A superelement keeps the orientation it was built in: place '{}' at {:?}, or build the part with its p → q along {:?} (`transform` selects the velocity transformation B1/B2/B3, not a placement)",
+                    a.p.0, a.q.0, snap(d, 1.0), snap(a.x, 1.0), a.q.0, snap(q, scale), snap(d, 1.0)
+                )
+            }
+            None => "scenes have no initial stress or prestrain, so every element must be undeformed where its nodes are: correct the node positions".into(),
+        };
+        return Err(ModelError::invalid(
+            format!("element '{}' ({})", e.id, e.element.type_name()),
+            format!("{what}: {fix}"),
+        ));
+    }
+    Ok(())
 }
 
 fn vec3(ctx: &str, what: &str, v: &[f64]) -> Result<[f64; 3], ModelError> {

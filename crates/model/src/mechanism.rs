@@ -221,6 +221,23 @@ impl Mechanism {
             })
             .collect()
     }
+    /// The first element that has flipped at the nodal coordinates `x` (its
+    /// chord turned by more than π/2 against a node frame,
+    /// [`Element::is_flipped`]), with that angle (rad): a spurious state of the
+    /// periodic deformation functions. No allocation: cheap enough for every
+    /// Newton iterate.
+    pub fn flipped_element(&self, x: &[f64]) -> Option<(&MechElement, f64)> {
+        // the chord and the node frames are in the first 14 local coordinates
+        let mut xl = [0.0; 14];
+        self.elements.iter().find_map(|e| {
+            let n = e.x_index.len().min(xl.len());
+            e.gather(x, &mut xl[..n]);
+            e.element
+                .is_flipped(&xl[..n])
+                .then(|| (e, e.element.chord_angle(&xl[..n]).unwrap_or(f64::NAN)))
+        })
+    }
+
     /// A one-line summary.
     pub fn summary(&self) -> String {
         format!(
