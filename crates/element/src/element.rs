@@ -467,6 +467,24 @@ impl Element {
                 why: "must be symmetric positive semi-definite".into(),
             });
         }
+        // a real mass distribution has principal moments that satisfy the
+        // triangle inequality J_a + J_b ≥ J_c (equality for a flat plate)
+        let ev = jm.symmetric_eigenvalues();
+        let (lo, hi) = (ev.min(), ev.max());
+        let sum = ev.sum();
+        if sum - hi < hi * (1.0 - 1e-9) && hi > 0.0 {
+            return Err(ElementError::InvalidProperty {
+                what: "rigid body inertia tensor".into(),
+                value: hi,
+                why: format!(
+                    "its principal moments ({:.6e}, {:.6e}, {:.6e}) break the triangle inequality: the largest ({hi:.6e}) exceeds the sum of the other two ({:.6e}); no mass distribution has such an inertia (is it given about the centre of mass, in kg m²?)",
+                    lo,
+                    sum - lo - hi,
+                    hi,
+                    sum - hi
+                ),
+            });
+        }
         let cx = Matrix3::new(0.0, -c[2], c[1], c[2], 0.0, -c[0], -c[1], c[0], 0.0);
         let mut mbar = DMatrix::zeros(6, 6);
         let top_right = -cx * m;

@@ -389,3 +389,24 @@ fn superelement_files_with_unknown_fields_are_rejected() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// An inertia tensor whose principal moments break the triangle inequality
+/// (no mass distribution has it: e.g. an inertia about the node instead of
+/// the centre of mass, or a typo) is refused naming the element; a flat
+/// plate, on the bound, is accepted.
+#[test]
+fn a_rigid_body_inertia_no_body_can_have_is_refused() {
+    let scene = |j: &str| {
+        format!(
+            r#"(
+        dimension: Spatial,
+        nodes: [ (id: "C", at: [0.0, 0.0, 0.0]) ],
+        elements: [ (id: "plate", type: RigidBody(node: "C", mass: 0.05, inertia: {j})) ],
+    )"#
+        )
+    };
+    let e = err(&scene("[[1.0e-3, 0.0, 0.0], [0.0, 1.0e-3, 0.0], [0.0, 0.0, 3.0e-3]]"));
+    assert!(e.contains("plate") && e.contains("triangle inequality"), "{e}");
+    let flat = "[[1.0e-3, 0.0, 0.0], [0.0, 0.6e-3, 0.0], [0.0, 0.0, 1.6e-3]]";
+    Scene::from_ron_str(&scene(flat)).unwrap().build(None).unwrap();
+}
