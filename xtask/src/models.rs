@@ -81,15 +81,19 @@ impl NodeProbe {
             at: node.at.clone(),
         })
     }
-    /// The node's displacement at (q, t).
+    /// The node's displacement at (q, t), solved from the last probed
+    /// configuration: probe along a path, in order.
     pub fn displacement(&mut self, q: &[f64], t: f64) -> Result<Vec<f64>, String> {
         self.kin.solve(q, t).map_err(|e| e.to_string())?;
-        Ok(self
-            .index
+        Ok(self.displacement_in(self.kin.x()))
+    }
+    /// The node's displacement in the configuration x (nodal coordinates).
+    pub fn displacement_in(&self, x: &[f64]) -> Vec<f64> {
+        self.index
             .iter()
             .zip(&self.at)
-            .map(|(i, a)| self.kin.x()[*i] - a)
-            .collect())
+            .map(|(i, a)| x[*i] - a)
+            .collect()
     }
 }
 
@@ -244,6 +248,8 @@ pub struct Response {
     pub position: Vec<Vec<f64>>,
     /// The DOFs q at each output time.
     pub q: Vec<Vec<f64>>,
+    /// The nodal coordinates x at each output time, solved along the run.
+    pub x: Vec<Vec<f64>>,
     /// The reduced coordinates z at each output time (reduced models).
     pub z: Option<Vec<Vec<f64>>>,
     /// Right-hand-side (or residual) evaluations.
@@ -276,11 +282,11 @@ pub fn simulate(
         opts.rtol,
         opts.atol
     );
-    let mut probe = NodeProbe::new(&model.mech, node)?;
+    let probe = NodeProbe::new(&model.mech, node)?;
     let mut s = Solver::new(model);
     s.equilibrium(t0, 1.0, true).map_err(ctx)?;
     let start = s.state();
-    let (t, q, z, evaluations, steps, wall_time) = match s {
+    let (t, q, x, z, evaluations, steps, wall_time) = match s {
         Solver::Full(mut dy, _) => {
             let qd0 = vec![0.0; start.len()];
             let tr = dy
@@ -292,6 +298,7 @@ pub fn simulate(
             (
                 tr.t,
                 tr.q,
+                tr.x,
                 None,
                 tr.stats.rhs_evals as u64,
                 tr.stats.steps_accepted as u64,
@@ -310,6 +317,7 @@ pub fn simulate(
             (
                 tr.t,
                 q,
+                tr.x,
                 Some(tr.z),
                 tr.stats.rhs_evals as u64,
                 tr.stats.steps_accepted as u64,
@@ -317,16 +325,13 @@ pub fn simulate(
             )
         }
     };
-    let position = t
-        .iter()
-        .zip(&q)
-        .map(|(tt, qq)| probe.displacement(qq, *tt))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(ctx)?;
+    // from the configurations solved along the run (not again afterwards)
+    let position = x.iter().map(|xx| probe.displacement_in(xx)).collect();
     Ok(Response {
         t,
         position,
         q,
+        x,
         z,
         evaluations,
         steps,
@@ -344,8 +349,10 @@ pub fn frequencies_along(
     count: usize,
 ) -> Result<Vec<f64>, String> {
     let t = r.t[i];
+    // the position solves start at the configuration of the response there
     match (model.reduced(), &r.z) {
         (Some(mut red), Some(z)) => {
+            red.dynamics_mut().kinematics_mut().set_guess(&r.x[i]);
             let f = red
                 .frequencies_at_rest(t, &z[i])
                 .map_err(|e| e.to_string())?;
@@ -353,6 +360,7 @@ pub fn frequencies_along(
         }
         _ => {
             let mut dy = Dynamics::new(model.mech.clone());
+            dy.kinematics_mut().set_guess(&r.x[i]);
             let lin = dy
                 .linearize_at_rest(t, &r.q[i])
                 .map_err(|e| e.to_string())?;

@@ -4,7 +4,7 @@
 
 use crate::report::{count_bar, write_frequency_sweep, FrequencySweep, Response};
 use crate::{Failure, SweepArgs};
-use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions};
+use flexmb_dynamics::{Control, Integrator, SimulationOptions};
 use flexmb_model::Mechanism;
 use flexmb_reduction::{ReducedModel, SavedBasis, SavedModel};
 use std::path::Path;
@@ -74,7 +74,10 @@ pub(crate) fn simulate(
     }
     let nz = red.n_z();
     let (q0, _) = red.full_state(&z0, &vec![0.0; nz]);
-    let qd0 = Dynamics::new(mech.clone())
+    // the model's own dynamics: its position solve continues from the
+    // equilibrium it found (a fresh one would start at the reference)
+    let qd0 = red
+        .dynamics_mut()
         .initial_qd(0.0, &q0)
         .map_err(|e| Failure::Compute(e.to_string()))?;
     let zd0 = red.project_velocities(0.0, &z0, &qd0).map_err(compute)?;
@@ -92,6 +95,7 @@ pub(crate) fn simulate(
             t: traj.t,
             q,
             qd,
+            x: traj.x,
             stats: traj.stats,
             wall_time: traj.wall_time,
             stopped: traj.stopped,

@@ -8,6 +8,7 @@ use flexmb_ode::{
     Adams, AdamsOptions, Control, Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions,
     OdeSystem, Output, RhsError, SecondOrderSystem, Stats, Tolerance,
 };
+use std::cell::RefCell;
 use std::time::Instant;
 
 /// Mass, damping and stiffness tangents (M, C, K) of the residual.
@@ -75,6 +76,12 @@ pub struct Trajectory {
     pub q: Vec<Vec<f64>>,
     /// q̇ at each output time.
     pub qd: Vec<Vec<f64>>,
+    /// The nodal coordinates x = F(q) at each output time, solved when the
+    /// integrator reached the output from the configuration it had there
+    /// (see [`Dynamics::output_configuration`]): the branch of the motion,
+    /// whatever the run does later. Outputs start their position solves here
+    /// ([`OutputTable::row`](crate::OutputTable::row)).
+    pub x: Vec<Vec<f64>>,
     /// Integrator statistics (exact evaluation counts).
     pub stats: Stats,
     /// Wall time of the integration in seconds.
@@ -83,17 +90,75 @@ pub struct Trajectory {
     pub stopped: bool,
 }
 
+/// A system shared by the integrator and its output observer, so that the
+/// observer can evaluate outputs with the system's own state (the
+/// configuration of the integrator's last evaluation). The integrator never
+/// evaluates the system while the observer runs, so the two borrows never
+/// meet; if they did, the evaluation would fail with an error, not a panic.
+struct Shared<'c, 's, S: ?Sized> {
+    cell: &'c RefCell<&'s mut S>,
+    dim: usize,
+}
+
+impl<'c, 's, S: ?Sized> Shared<'c, 's, S> {
+    fn system(&self) -> Result<std::cell::RefMut<'c, &'s mut S>, RhsError> {
+        self.cell
+            .try_borrow_mut()
+            .map_err(|_| RhsError::new("the system was evaluated while an output was recorded"))
+    }
+}
+
+impl<S: OdeSystem + ?Sized> OdeSystem for Shared<'_, '_, S> {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        self.system()?.rhs(t, y, dy)
+    }
+}
+
+impl<S: SecondOrderSystem + ?Sized> SecondOrderSystem for Shared<'_, '_, S> {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    fn residual(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        r: &mut [f64],
+    ) -> Result<(), RhsError> {
+        self.system()?.residual(t, q, qd, qdd, r)
+    }
+    fn tangent(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        mass: &mut Mat<f64>,
+        damping: &mut Mat<f64>,
+        stiffness: &mut Mat<f64>,
+    ) -> Result<(), RhsError> {
+        self.system()?
+            .tangent(t, q, qd, qdd, mass, damping, stiffness)
+    }
+}
+
 /// Integrates a first-order system y' = f(t, y) with one of the explicit
 /// integrators (Dopri5 or Adams) from (t0, y0) to the last output time of
-/// `opts`; `observer(t, y)` sees each output and may stop the run. Returns
-/// the integrator's statistics and whether the observer stopped it. Reduced
+/// `opts`; `observer(sys, t, y)` sees each output, with the system in the
+/// state of the integrator's last evaluation (e.g. to solve the output's
+/// configuration from there), and may stop the run. Returns the
+/// integrator's statistics and whether the observer stopped it. Reduced
 /// models use this exactly like the unreduced equations of motion.
 pub fn integrate_explicit<S: OdeSystem + ?Sized>(
     sys: &mut S,
     opts: &SimulationOptions,
     t0: f64,
     y0: &[f64],
-    mut observer: impl FnMut(f64, &[f64]) -> Control,
+    mut observer: impl FnMut(&mut S, f64, &[f64]) -> Control,
 ) -> Result<(Stats, bool), DynamicsError> {
     let t_end = *opts
         .output_times
@@ -101,6 +166,14 @@ pub fn integrate_explicit<S: OdeSystem + ?Sized>(
         .ok_or_else(|| DynamicsError::Invalid("no output times".into()))?;
     let out = Output::Times(opts.output_times.clone());
     let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(e.to_string());
+    let dim = sys.dim();
+    let cell = RefCell::new(sys);
+    let mut shared = Shared { cell: &cell, dim };
+    let mut observe = |t: f64, y: &[f64]| match cell.try_borrow_mut() {
+        Ok(mut s) => observer(&mut **s, t, y),
+        // (unreachable: the integrator is not evaluating the system)
+        Err(_) => Control::Stop,
+    };
     let sol = match opts.integrator {
         Integrator::Dopri5 => {
             let o = Dopri5Options {
@@ -109,7 +182,7 @@ pub fn integrate_explicit<S: OdeSystem + ?Sized>(
                 ..Default::default()
             };
             Dopri5::new(o)
-                .solve_with(sys, t0, y0, t_end, &out, &mut observer)
+                .solve_with(&mut shared, t0, y0, t_end, &out, &mut observe)
                 .map_err(to_err)?
         }
         Integrator::Adams => {
@@ -119,7 +192,7 @@ pub fn integrate_explicit<S: OdeSystem + ?Sized>(
                 ..Default::default()
             };
             Adams::new(o)
-                .solve_with(sys, t0, y0, t_end, &out, &mut observer)
+                .solve_with(&mut shared, t0, y0, t_end, &out, &mut observe)
                 .map_err(to_err)?
         }
         Integrator::GeneralizedAlpha => {
@@ -132,6 +205,29 @@ pub fn integrate_explicit<S: OdeSystem + ?Sized>(
         sol.stats.clone(),
         !matches!(sol.status, flexmb_ode::Status::Completed),
     ))
+}
+
+/// Records the output point (t, q, q̇) in `traj` with its configuration,
+/// solved from the state of the integrator's last evaluation in `dy`; a
+/// failure is kept in `failure` and stops the run. Then asks `observer`.
+fn record_output(
+    traj: &mut Trajectory,
+    failure: &mut Option<DynamicsError>,
+    dy: &mut Dynamics,
+    (t, q, qd): (f64, &[f64], &[f64]),
+    observer: &mut impl FnMut(f64, &[f64], &[f64]) -> Control,
+) -> Control {
+    match dy.output_configuration(t, q) {
+        Ok(x) => traj.x.push(x),
+        Err(e) => {
+            *failure = Some(e);
+            return Control::Stop;
+        }
+    }
+    traj.t.push(t);
+    traj.q.push(q.to_vec());
+    traj.qd.push(qd.to_vec());
+    observer(t, q, qd)
 }
 
 /// Kinematic failures at a trial state are recoverable (a smaller step
@@ -282,8 +378,30 @@ impl Dynamics {
         d
     }
 
+    /// The nodal coordinates x = F(q) at an output point (t, q) that the
+    /// integrator has reached, solved by a kinematics of their own that
+    /// starts from this dynamics' current configuration: the one of the
+    /// integrator's last evaluation, within a step of t. So the output lies
+    /// on the branch the integrator followed (a solve from a far-away
+    /// configuration, e.g. the end of the run, can land on a mirrored one),
+    /// and the integrator's own kinematics, and with it the run, is not
+    /// disturbed.
+    pub fn output_configuration(&mut self, t: f64, q: &[f64]) -> Result<Vec<f64>, DynamicsError> {
+        let mech = &self.mech;
+        let kin = self
+            .output_kin
+            .get_or_insert_with(|| flexmb_kinematics::Kinematics::new(mech.clone()));
+        kin.set_newton_options(self.kin.newton_options());
+        kin.set_guess(self.kin.x());
+        kin.solve(q, t)
+            .map_err(|e| DynamicsError::Kinematics { t, source: e })?;
+        Ok(kin.x().to_vec())
+    }
+
     /// Integrates from (t0, q0, q̇0) to the last output time. `observer(t, q, q̇)`
-    /// is called at each output time and may stop the run (partial results are kept).
+    /// is called at each output time and may stop the run (partial results
+    /// are kept). The trajectory holds each output's configuration x, solved
+    /// when the integrator reached it ([`Self::output_configuration`]).
     pub fn simulate(
         &mut self,
         t0: f64,
@@ -302,10 +420,12 @@ impl Dynamics {
             t: vec![],
             q: vec![],
             qd: vec![],
+            x: vec![],
             stats: Stats::default(),
             wall_time: 0.0,
             stopped: false,
         };
+        let mut failure = None;
         let start = Instant::now();
         let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(e.to_string());
         match opts.integrator {
@@ -314,11 +434,9 @@ impl Dynamics {
                 y0.extend_from_slice(qd0);
                 let mut sys = self.first_order_system();
                 let (stats, stopped) =
-                    integrate_explicit(&mut sys, opts, t0, &y0, |t: f64, y: &[f64]| {
-                        traj.t.push(t);
-                        traj.q.push(y[..n].to_vec());
-                        traj.qd.push(y[n..].to_vec());
-                        observer(t, &y[..n], &y[n..])
+                    integrate_explicit(&mut sys, opts, t0, &y0, |sys, t: f64, y: &[f64]| {
+                        let (q, qd) = y.split_at(n);
+                        record_output(&mut traj, &mut failure, sys.dy, (t, q, qd), &mut observer)
                     })?;
                 traj.stats = stats;
                 traj.stopped = stopped;
@@ -329,18 +447,33 @@ impl Dynamics {
                     atol: Tolerance::Scalar(opts.atol),
                     ..Default::default()
                 };
-                let mut sys = Residual { dy: self };
+                let mut res = Residual { dy: self };
+                let cell = RefCell::new(&mut res);
+                let mut shared = Shared {
+                    cell: &cell,
+                    dim: n,
+                };
                 let sol = GeneralizedAlpha::new(o)
-                    .solve_with(&mut sys, t0, q0, qd0, t_end, &out, |t, q, qd, _| {
-                        traj.t.push(t);
-                        traj.q.push(q.to_vec());
-                        traj.qd.push(qd.to_vec());
-                        observer(t, q, qd)
+                    .solve_with(&mut shared, t0, q0, qd0, t_end, &out, |t, q, qd, _| {
+                        match cell.try_borrow_mut() {
+                            Ok(mut r) => record_output(
+                                &mut traj,
+                                &mut failure,
+                                r.dy,
+                                (t, q, qd),
+                                &mut observer,
+                            ),
+                            // (unreachable: the integrator is not evaluating the system)
+                            Err(_) => Control::Stop,
+                        }
                     })
                     .map_err(to_err)?;
                 traj.stats = sol.stats.clone();
                 traj.stopped = !matches!(sol.status, flexmb_ode::Status::Completed);
             }
+        }
+        if let Some(e) = failure {
+            return Err(e);
         }
         traj.wall_time = start.elapsed().as_secs_f64();
         Ok(traj)

@@ -349,6 +349,11 @@ impl Kinematics {
         s
     }
 
+    /// The Newton settings of the position solve.
+    pub fn newton_options(&self) -> NewtonOptions {
+        self.opts
+    }
+
     /// Sets the Newton options.
     pub fn set_newton_options(&mut self, o: NewtonOptions) {
         self.opts = o;
