@@ -841,3 +841,64 @@ fn simulate_outputs_do_not_depend_on_the_length_of_the_run() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Item 4: `static` writes the equilibrium the solver found. It used to
+/// solve x = F(q) again from the undeformed shape, which for the 64-beam
+/// roll-up (fixtures/scenes/rollup_planar.ron) could fail after "equilibrium
+/// found" or land elsewhere. `--steps 64` is 64 equal load increments (it
+/// was a first increment of 1/64 that then doubled, 7 increments), which
+/// reach the closed form: a cantilever under the end moment M = 2πEI/L
+/// curls into a full circle, the tip B returns to the root A = (0, 0). The
+/// written positions are the library's equilibrium to the CSV's 13 digits
+/// (measured tip: (1.61e-3, 8.2e-6) m, the 64-beam discretization error).
+#[test]
+fn static_writes_the_equilibrium_it_found() {
+    let dir = temp_dir("rollup");
+    let scene = fixture("rollup_planar.ron");
+    let o = dir.display().to_string();
+    let stdout = run_ok(&["static", &scene, "--steps", "64", "--out", &o]);
+    assert!(
+        stdout.contains("64 load increments"),
+        "64 equal increments: {stdout}"
+    );
+    let (h, rows) = flexmb_plot_read(&dir.join("node_positions.csv"));
+    assert_eq!(h, ["x", "y"]);
+    // the same equilibrium through the library: its configuration
+    let mech = std::sync::Arc::new(
+        flexmb_model::Scene::load(Path::new(&scene))
+            .unwrap()
+            .build(None)
+            .unwrap(),
+    );
+    let mut dy = flexmb_dynamics::Dynamics::new(mech.clone());
+    let opts = flexmb_dynamics::StaticOptions {
+        load_steps: 64,
+        ..Default::default()
+    };
+    dy.static_equilibrium(0.0, &mech.q0(), &opts).unwrap();
+    let x = dy.kinematics().x();
+    assert_eq!(rows.len(), mech.nodes.len());
+    for (n, r) in mech.nodes.iter().zip(&rows) {
+        for (i, v) in n.position.iter().zip(r) {
+            assert!(
+                (x[*i] - v).abs() <= 1e-11 * (1.0 + v.abs()),
+                "{}: written {v}, equilibrium {}",
+                n.id,
+                x[*i]
+            );
+        }
+    }
+    let b = mech.nodes.iter().position(|n| n.id == "B").unwrap();
+    let (bx, by) = (rows[b][0], rows[b][1]);
+    assert!(
+        bx.hypot(by) < 2e-3,
+        "tip B at ({bx:.3e}, {by:.3e}), the closed form puts it at the root (0, 0)"
+    );
+    let eps = std::fs::read_to_string(dir.join("deformations.csv")).unwrap();
+    assert_eq!(
+        eps.lines().filter(|l| !l.starts_with('#')).count(),
+        1 + mech.n_eps(),
+        "header + one row per deformation"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
