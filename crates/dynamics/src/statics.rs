@@ -314,6 +314,9 @@ impl Dynamics {
         let mut iterations = 0;
         let mut increments = 0;
         let mut last_good = q.clone();
+        // the configuration of `last_good` (at first the one the kinematics
+        // starts from), where a retried increment starts its position solve
+        let mut last_good_x = self.kin.x().to_vec();
         let mut last_err = None;
         let mut force_refresh = false;
         while lambda < 1.0 - 1e-15 {
@@ -376,12 +379,13 @@ impl Dynamics {
                 lambda = target;
                 increments += 1;
                 last_good.copy_from_slice(&q);
+                last_good_x.copy_from_slice(self.kin.x());
                 dl = (dl * 2.0).min(max_dl);
             } else {
                 // retry a smaller increment with a tangent at its start
                 force_refresh = true;
                 q.copy_from_slice(&last_good);
-                self.kin.set_guess(&self.mech.x0.clone());
+                self.kin.set_guess(&last_good_x);
                 let _ = self.kin.solve(&q, t);
                 dl *= 0.5;
                 if dl < opts.min_increment {
