@@ -56,7 +56,7 @@ pub(crate) fn simulate(
             .map_err(|e| Failure::Compute(format!("reduced static equilibrium: {e}")))?;
         z.into_iter()
             .next()
-            .unwrap_or_else(|| red.basis().z_reference())
+            .map_or_else(|| red.basis().z_reference(), |e| e.z)
     } else {
         red.basis().z_reference()
     };
@@ -132,9 +132,11 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
             .equilibria_over_load_scale(a.t_load, values, &mut |d| pb.set_position(d as u64))
             .map_err(|e| Failure::Compute(format!("reduced sweep: {e}")))?;
         let mut freqs = Vec::with_capacity(n);
-        for (i, (l, z)) in values.iter().zip(&zs).enumerate() {
+        for (i, (l, eq)) in values.iter().zip(&zs).enumerate() {
             red.set_load_scale(*l);
-            let f = red.frequencies_at_rest(a.t_load, z).map_err(|e| {
+            // the position solve starts at this equilibrium's configuration
+            red.dynamics_mut().kinematics_mut().set_guess(&eq.x);
+            let f = red.frequencies_at_rest(a.t_load, &eq.z).map_err(|e| {
                 Failure::Compute(format!("reduced eigenfrequencies at load scale {l}: {e}"))
             })?;
             freqs.push(f.into_iter().take(k).collect::<Vec<f64>>());
