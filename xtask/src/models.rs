@@ -3,7 +3,6 @@
 //! time responses with their cost.
 
 use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions, StaticOptions};
-use flexmb_kinematics::Kinematics;
 use flexmb_linearize::undamped_modes;
 use flexmb_model::Mechanism;
 use flexmb_reduction::{load_scale_path, Basis, FixedBasis, InterpolatedBasis, ReducedModel};
@@ -61,10 +60,9 @@ impl Model {
     }
 }
 
-/// Displacements of one node (from its reference position) from the degrees
-/// of freedom.
+/// Displacements of one node (from its reference position) in a
+/// configuration that a solver found (no position solve of its own).
 pub struct NodeProbe {
-    kin: Kinematics,
     index: Vec<usize>,
     at: Vec<f64>,
 }
@@ -76,20 +74,17 @@ impl NodeProbe {
             .node(id)
             .ok_or_else(|| format!("no node '{id}' in {}", mech.name))?;
         Ok(Self {
-            kin: Kinematics::new(mech.clone()),
             index: node.position.clone(),
             at: node.at.clone(),
         })
     }
-    /// The node's displacement at (q, t).
-    pub fn displacement(&mut self, q: &[f64], t: f64) -> Result<Vec<f64>, String> {
-        self.kin.solve(q, t).map_err(|e| e.to_string())?;
-        Ok(self
-            .index
+    /// The node's displacement in the configuration x (nodal coordinates).
+    pub fn displacement_in(&self, x: &[f64]) -> Vec<f64> {
+        self.index
             .iter()
             .zip(&self.at)
-            .map(|(i, a)| self.kin.x()[*i] - a)
-            .collect())
+            .map(|(i, a)| x[*i] - a)
+            .collect()
     }
 }
 
@@ -161,14 +156,18 @@ impl Solver {
         }
         Ok(())
     }
-    /// The full DOFs of the current state.
-    fn q(&mut self) -> Vec<f64> {
+    /// The nodal coordinates of the last position solve.
+    fn x(&self) -> Vec<f64> {
         match self {
-            Solver::Full(_, q) => q.clone(),
-            Solver::Reduced(r, z) => {
-                let z = z.clone();
-                r.full_coordinates(&z)
-            }
+            Solver::Full(dy, _) => dy.kinematics().x().to_vec(),
+            Solver::Reduced(r, _) => r.dynamics().kinematics().x().to_vec(),
+        }
+    }
+    /// Starts the next position solve at the configuration x.
+    fn set_guess(&mut self, x: &[f64]) {
+        match self {
+            Solver::Full(dy, _) => dy.kinematics_mut().set_guess(x),
+            Solver::Reduced(r, _) => r.dynamics_mut().kinematics_mut().set_guess(x),
         }
     }
     /// Eigenfrequencies at the current state (load scale as last set).
@@ -205,29 +204,34 @@ pub fn quasi_static_curve(
     count: usize,
 ) -> Result<Vec<CurvePoint>, String> {
     let ctx = |e: String| format!("{}: {e}", model.name);
-    let mut probe = NodeProbe::new(&model.mech, node)?;
+    let probe = NodeProbe::new(&model.mech, node)?;
     let mut s = Solver::new(model);
     s.equilibrium(t, 0.0, true).map_err(ctx)?;
-    let at_zero = s.state();
+    // a state is the equilibrium and its configuration: every position solve
+    // starts at the configuration of the equilibrium it continues from or
+    // evaluates, never at another end of the path
+    let at_zero = (s.state(), s.x());
     // continuation outwards from λ = 0 (shared with `flexmb sweep --reduced`)
-    let mut solve = |state: &Vec<f64>, l: f64| -> Result<Vec<f64>, String> {
-        s.set_state(state.clone());
+    type State = (Vec<f64>, Vec<f64>);
+    let mut solve = |state: &State, l: f64| -> Result<State, String> {
+        s.set_state(state.0.clone());
+        s.set_guess(&state.1);
         s.equilibrium(t, l, false)?;
-        Ok(s.state())
+        Ok((s.state(), s.x()))
     };
     let states = load_scale_path(&at_zero, lambdas, &mut solve, &mut |_| {})
         .map_err(|e| ctx(e.to_string()))?;
     lambdas
         .iter()
         .zip(states)
-        .map(|(l, state)| {
+        .map(|(l, (state, x))| {
             s.set_state(state);
+            s.set_guess(&x);
             s.set_load_scale(*l);
-            let q = s.q();
             let (freqs, highest) = s.frequencies(t, count).map_err(ctx)?;
             Ok(CurvePoint {
                 lambda: *l,
-                position: probe.displacement(&q, t).map_err(ctx)?,
+                position: probe.displacement_in(&x),
                 freqs,
                 highest,
             })
@@ -244,6 +248,8 @@ pub struct Response {
     pub position: Vec<Vec<f64>>,
     /// The DOFs q at each output time.
     pub q: Vec<Vec<f64>>,
+    /// The nodal coordinates x at each output time, solved along the run.
+    pub x: Vec<Vec<f64>>,
     /// The reduced coordinates z at each output time (reduced models).
     pub z: Option<Vec<Vec<f64>>>,
     /// Right-hand-side (or residual) evaluations.
@@ -276,11 +282,11 @@ pub fn simulate(
         opts.rtol,
         opts.atol
     );
-    let mut probe = NodeProbe::new(&model.mech, node)?;
+    let probe = NodeProbe::new(&model.mech, node)?;
     let mut s = Solver::new(model);
     s.equilibrium(t0, 1.0, true).map_err(ctx)?;
     let start = s.state();
-    let (t, q, z, evaluations, steps, wall_time) = match s {
+    let (t, q, x, z, evaluations, steps, wall_time) = match s {
         Solver::Full(mut dy, _) => {
             let qd0 = vec![0.0; start.len()];
             let tr = dy
@@ -292,6 +298,7 @@ pub fn simulate(
             (
                 tr.t,
                 tr.q,
+                tr.x,
                 None,
                 tr.stats.rhs_evals as u64,
                 tr.stats.steps_accepted as u64,
@@ -310,6 +317,7 @@ pub fn simulate(
             (
                 tr.t,
                 q,
+                tr.x,
                 Some(tr.z),
                 tr.stats.rhs_evals as u64,
                 tr.stats.steps_accepted as u64,
@@ -317,16 +325,13 @@ pub fn simulate(
             )
         }
     };
-    let position = t
-        .iter()
-        .zip(&q)
-        .map(|(tt, qq)| probe.displacement(qq, *tt))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(ctx)?;
+    // from the configurations solved along the run (not again afterwards)
+    let position = x.iter().map(|xx| probe.displacement_in(xx)).collect();
     Ok(Response {
         t,
         position,
         q,
+        x,
         z,
         evaluations,
         steps,
@@ -344,8 +349,10 @@ pub fn frequencies_along(
     count: usize,
 ) -> Result<Vec<f64>, String> {
     let t = r.t[i];
+    // the position solves start at the configuration of the response there
     match (model.reduced(), &r.z) {
         (Some(mut red), Some(z)) => {
+            red.dynamics_mut().kinematics_mut().set_guess(&r.x[i]);
             let f = red
                 .frequencies_at_rest(t, &z[i])
                 .map_err(|e| e.to_string())?;
@@ -353,6 +360,7 @@ pub fn frequencies_along(
         }
         _ => {
             let mut dy = Dynamics::new(model.mech.clone());
+            dy.kinematics_mut().set_guess(&r.x[i]);
             let lin = dy
                 .linearize_at_rest(t, &r.q[i])
                 .map_err(|e| e.to_string())?;

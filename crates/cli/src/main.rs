@@ -49,7 +49,8 @@ enum Command {
         /// Time at which loads and inputs are evaluated.
         #[arg(long, default_value_t = 0.0)]
         time: f64,
-        /// Initial number of load increments.
+        /// Number of equal load increments (each halved while its Newton
+        /// iteration fails).
         #[arg(long, default_value_t = 1)]
         steps: usize,
         /// Output directory.
@@ -254,30 +255,28 @@ fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure>
     let sol = dy
         .static_equilibrium(t, &mech.q0(), &opts)
         .map_err(|e| Failure::Compute(e.to_string()))?;
+    // the configuration the solver converged to (solving x = F(q) again from
+    // the reference configuration can fail or land on another branch),
+    // checked before anything is printed or written
+    let what = "static equilibrium";
+    finite::check(what, sol.x.iter().copied(), |i| mech.x_names[i].clone())?;
+    finite::check(what, sol.eps.iter().copied(), |j| mech.eps_names[j].clone())?;
     println!("{}", mech.summary());
     println!(
         "equilibrium found in {} Newton iterations, {} load increments",
         sol.iterations, sol.increments
     );
     std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
-    let mut kin = flexmb_kinematics::Kinematics::new(mech.clone());
-    kin.solve(&sol.q, t)
-        .map_err(|e| Failure::Compute(e.to_string()))?;
-    let what = "static equilibrium";
-    finite::check(what, kin.x().iter().copied(), |i| mech.x_names[i].clone())?;
-    finite::check(what, kin.eps().iter().copied(), |j| {
-        mech.eps_names[j].clone()
-    })?;
     let mut rows = vec![];
     for n in &mech.nodes {
         let d: Vec<String> = n
             .position
             .iter()
             .zip(&n.at)
-            .map(|(i, a)| format!("{:+.6e}", kin.x()[*i] - a))
+            .map(|(i, a)| format!("{:+.6e}", sol.x[*i] - a))
             .collect();
         println!("  {:<14} displacement [{}]", n.id, d.join(", "));
-        rows.push(n.position.iter().map(|i| kin.x()[*i]).collect::<Vec<f64>>());
+        rows.push(n.position.iter().map(|i| sol.x[*i]).collect::<Vec<f64>>());
     }
     let dim = mech.nodes.first().map_or(3, |n| n.position.len());
     let header: Vec<String> = ["x", "y", "z"]
@@ -298,7 +297,7 @@ fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure>
     )
     .map_err(|e| io_err(e, &p))?;
     let p = out.join("deformations.csv");
-    let eps: Vec<Vec<f64>> = kin.eps().iter().map(|v| vec![*v]).collect();
+    let eps: Vec<Vec<f64>> = sol.eps.iter().map(|v| vec![*v]).collect();
     write_csv(
         &p,
         &[format!("rows: {}", mech.eps_names.join(" "))],

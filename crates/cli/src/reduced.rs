@@ -4,7 +4,7 @@
 
 use crate::report::{count_bar, write_frequency_sweep, FrequencySweep, Response};
 use crate::{Failure, SweepArgs};
-use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions};
+use flexmb_dynamics::{Control, Integrator, SimulationOptions};
 use flexmb_model::Mechanism;
 use flexmb_reduction::{ReducedModel, SavedBasis, SavedModel};
 use std::path::Path;
@@ -56,7 +56,7 @@ pub(crate) fn simulate(
             .map_err(|e| Failure::Compute(format!("reduced static equilibrium: {e}")))?;
         z.into_iter()
             .next()
-            .unwrap_or_else(|| red.basis().z_reference())
+            .map_or_else(|| red.basis().z_reference(), |e| e.z)
     } else {
         red.basis().z_reference()
     };
@@ -74,7 +74,10 @@ pub(crate) fn simulate(
     }
     let nz = red.n_z();
     let (q0, _) = red.full_state(&z0, &vec![0.0; nz]);
-    let qd0 = Dynamics::new(mech.clone())
+    // the model's own dynamics: its position solve continues from the
+    // equilibrium it found (a fresh one would start at the reference)
+    let qd0 = red
+        .dynamics_mut()
         .initial_qd(0.0, &q0)
         .map_err(|e| Failure::Compute(e.to_string()))?;
     let zd0 = red.project_velocities(0.0, &z0, &qd0).map_err(compute)?;
@@ -92,10 +95,10 @@ pub(crate) fn simulate(
             t: traj.t,
             q,
             qd,
+            x: traj.x,
             stats: traj.stats,
             wall_time: traj.wall_time,
             stopped: traj.stopped,
-            x: vec![],
             chart_switches: vec![],
         },
         saved.description,
@@ -130,9 +133,11 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
             .equilibria_over_load_scale(a.t_load, values, &mut |d| pb.set_position(d as u64))
             .map_err(|e| Failure::Compute(format!("reduced sweep: {e}")))?;
         let mut freqs = Vec::with_capacity(n);
-        for (i, (l, z)) in values.iter().zip(&zs).enumerate() {
+        for (i, (l, eq)) in values.iter().zip(&zs).enumerate() {
             red.set_load_scale(*l);
-            let f = red.frequencies_at_rest(a.t_load, z).map_err(|e| {
+            // the position solve starts at this equilibrium's configuration
+            red.dynamics_mut().kinematics_mut().set_guess(&eq.x);
+            let f = red.frequencies_at_rest(a.t_load, &eq.z).map_err(|e| {
                 Failure::Compute(format!("reduced eigenfrequencies at load scale {l}: {e}"))
             })?;
             freqs.push(f.into_iter().take(k).collect::<Vec<f64>>());

@@ -45,7 +45,8 @@ pub(crate) fn time_bar() -> ProgressBar {
 }
 
 /// A time response in the unreduced coordinates (a reduced one mapped by
-/// q = G(z), q̇ = G,z ż) and what it cost: the dynamics' trajectory.
+/// q = G(z), q̇ = G,z ż) with the configuration x at each output, solved
+/// along the run, and what it cost: the dynamics' trajectory.
 pub(crate) use flexmb_dynamics::Trajectory as Response;
 
 /// The line `flexmb simulate` prints: outputs, evaluations, steps, time.
@@ -62,7 +63,7 @@ pub(crate) fn summary(r: &Response) -> String {
 }
 
 /// Writes `out/outputs.csv` (the scene's outputs, or the DOFs, at each output
-/// time), `out/outputs.svg` (the first twelve columns) and `out/path_N.svg`
+/// time, each from the configuration the run had there), `out/outputs.svg` (the first twelve columns) and `out/path_N.svg`
 /// for every node N whose x and y are outputs.
 pub(crate) fn write_outputs(
     dy: &mut Dynamics,
@@ -73,11 +74,11 @@ pub(crate) fn write_outputs(
     std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
     let table = OutputTable::new(dy).map_err(|e| Failure::Input(e.to_string()))?;
     let mut rows = vec![];
-    for ((t, q), qd) in r.t.iter().zip(&r.q).zip(&r.qd) {
+    for (((t, q), qd), x) in r.t.iter().zip(&r.q).zip(&r.qd).zip(&r.x) {
         let mut row = vec![*t];
         row.extend(
             table
-                .row(dy, *t, q, qd)
+                .row(dy, *t, q, qd, x)
                 .map_err(|e| Failure::Compute(e.to_string()))?,
         );
         rows.push(row);

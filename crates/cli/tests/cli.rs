@@ -779,3 +779,126 @@ fn per_mode_svd_and_mac_sorted_models_report_and_bound_the_frequencies() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+// ---------------------------------------------------------------------------
+// Issue 13, items 2 and 4: results written from the configuration the solver
+// had, never solved again from a far-away one.
+
+/// Item 2: `simulate` used to solve every output again after the run, from
+/// its final configuration; at t = 0 of a 20 s spin-up that landed on the
+/// mirrored branch, tip at x = −8 m. At t = 0 the beam rests in its
+/// reference configuration, tip at the scene's (8, 0) m. The rows at
+/// t ≤ 5 s of a 5 s and a 20 s run (outputs every 0.04 s in both, DOPRI5 at
+/// rtol 1e-6, atol 1e-9) must agree: the runs differ only in step sizes
+/// chosen with the end time in view (measured 8.4e-11 m).
+#[test]
+fn simulate_outputs_do_not_depend_on_the_length_of_the_run() {
+    let dir = temp_dir("run-length");
+    let rows = |t_end: &str, outputs: &str| {
+        let out = dir.join(t_end);
+        let o = out.display().to_string();
+        run_ok(&[
+            "simulate",
+            &fixture("spin_up_planar.ron"),
+            "--t-end",
+            t_end,
+            "--outputs",
+            outputs,
+            "--rtol",
+            "1e-6",
+            "--atol",
+            "1e-9",
+            "--out",
+            &o,
+        ]);
+        flexmb_plot_read(&out.join("outputs.csv"))
+    };
+    let (h, long) = rows("20", "501");
+    let (_, short) = rows("5", "126");
+    assert_eq!(h, ["t", "T.x", "T.y"]);
+    for r in [&long, &short] {
+        assert!(
+            (r[0][1] - 8.0).abs() < 1e-9 && r[0][2].abs() < 1e-9,
+            "tip at t = 0 at ({}, {}), not (8, 0)",
+            r[0][1],
+            r[0][2]
+        );
+    }
+    assert_eq!(short.len(), 126);
+    let mut worst = 0.0f64;
+    for (a, b) in short.iter().zip(&long) {
+        assert!(
+            (a[0] - b[0]).abs() < 1e-12,
+            "output times {} {}",
+            a[0],
+            b[0]
+        );
+        worst = worst.max((a[1] - b[1]).abs()).max((a[2] - b[2]).abs());
+    }
+    assert!(
+        worst < 1e-9,
+        "rows at t ≤ 5 s differ by {worst:.3e} m between --t-end 5 and --t-end 20"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Item 4: `static` writes the equilibrium the solver found. It used to
+/// solve x = F(q) again from the undeformed shape, which for the 64-beam
+/// roll-up (fixtures/scenes/rollup_planar.ron) could fail after "equilibrium
+/// found" or land elsewhere. `--steps 64` is 64 equal load increments (it
+/// was a first increment of 1/64 that then doubled, 7 increments), which
+/// reach the closed form: a cantilever under the end moment M = 2πEI/L
+/// curls into a full circle, the tip B returns to the root A = (0, 0). The
+/// written positions are the library's equilibrium to the CSV's 13 digits
+/// (measured tip: (1.61e-3, 8.2e-6) m, the 64-beam discretization error).
+#[test]
+fn static_writes_the_equilibrium_it_found() {
+    let dir = temp_dir("rollup");
+    let scene = fixture("rollup_planar.ron");
+    let o = dir.display().to_string();
+    let stdout = run_ok(&["static", &scene, "--steps", "64", "--out", &o]);
+    assert!(
+        stdout.contains("64 load increments"),
+        "64 equal increments: {stdout}"
+    );
+    let (h, rows) = flexmb_plot_read(&dir.join("node_positions.csv"));
+    assert_eq!(h, ["x", "y"]);
+    // the same equilibrium through the library: its configuration
+    let mech = std::sync::Arc::new(
+        flexmb_model::Scene::load(Path::new(&scene))
+            .unwrap()
+            .build(None)
+            .unwrap(),
+    );
+    let mut dy = flexmb_dynamics::Dynamics::new(mech.clone());
+    let opts = flexmb_dynamics::StaticOptions {
+        load_steps: 64,
+        ..Default::default()
+    };
+    dy.static_equilibrium(0.0, &mech.q0(), &opts).unwrap();
+    let x = dy.kinematics().x();
+    assert_eq!(rows.len(), mech.nodes.len());
+    for (n, r) in mech.nodes.iter().zip(&rows) {
+        for (i, v) in n.position.iter().zip(r) {
+            assert!(
+                (x[*i] - v).abs() <= 1e-11 * (1.0 + v.abs()),
+                "{}: written {v}, equilibrium {}",
+                n.id,
+                x[*i]
+            );
+        }
+    }
+    let b = mech.nodes.iter().position(|n| n.id == "B").unwrap();
+    let (bx, by) = (rows[b][0], rows[b][1]);
+    assert!(
+        bx.hypot(by) < 2e-3,
+        "tip B at ({bx:.3e}, {by:.3e}), the closed form puts it at the root (0, 0)"
+    );
+    let eps = std::fs::read_to_string(dir.join("deformations.csv")).unwrap();
+    assert_eq!(
+        eps.lines().filter(|l| !l.starts_with('#')).count(),
+        1 + mech.n_eps(),
+        "header + one row per deformation"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -58,7 +58,7 @@ fn trajectory(file: &str) -> Vec<(f64, Vec<f64>)> {
         qdd: vec![0.0; n],
     };
     let opts = SimulationOptions::new(Integrator::Dopri5, 0.0, 2e-3, 4);
-    integrate_explicit(&mut rec, &opts, 0.0, &y0, |_, _| {
+    integrate_explicit(&mut rec, &opts, 0.0, &y0, |_, _, _| {
         flexmb_dynamics::Control::Continue
     })
     .unwrap();

@@ -239,6 +239,9 @@ pub struct Dynamics {
     pub(crate) load_scale: f64,
     /// The factorized static tangent of the last static Newton step (chord steps).
     pub(crate) static_factor: Option<crate::statics::StaticFactor>,
+    /// The position solve of outputs along a trajectory (made on first use),
+    /// apart from `kin` so that recording outputs leaves the run unchanged.
+    pub(crate) output_kin: Option<Kinematics>,
     pub(crate) evaluations: u64,
 }
 
@@ -264,6 +267,7 @@ impl Dynamics {
             load_factor: 1.0,
             load_scale: 1.0,
             static_factor: None,
+            output_kin: None,
             evaluations: 0,
             mech,
         }

@@ -128,7 +128,11 @@ impl OutputTable {
         })
     }
 
-    /// One row at (t, q, q̇). Rows must come in time order: the external
+    /// One row at (t, q, q̇), with `x` the configuration of the trajectory at
+    /// that point ([`Trajectory::x`](crate::Trajectory::x)): the position
+    /// solve starts there, so that the row is on the branch of the motion
+    /// and does not depend on what `dy` solved before (e.g. the end of a
+    /// long run). Rows must come in time order: the external
     /// work column is the work of loads, gravity and controllers since the
     /// first row, integrated over the rows by the trapezoidal rule (error
     /// O(Δt²) in the output interval), so that kinetic + elastic − external
@@ -139,7 +143,16 @@ impl OutputTable {
         t: f64,
         q: &[f64],
         qd: &[f64],
+        x: &[f64],
     ) -> Result<Vec<f64>, DynamicsError> {
+        if x.len() != dy.kin.x().len() {
+            return Err(DynamicsError::Invalid(format!(
+                "output row at t = {t}: a configuration of {} coordinates for {} nodal coordinates",
+                x.len(),
+                dy.kin.x().len()
+            )));
+        }
+        dy.kin.set_guess(x);
         let needs_energy = self
             .columns
             .iter()

@@ -129,17 +129,87 @@ pub struct OutputPoint<'a> {
     pub dynamics: &'a mut Dynamics,
 }
 
+/// A system shared by the integrator and its output observer, so that the
+/// observer can evaluate outputs with the system's own state (the
+/// configuration of the integrator's last evaluation). The integrator never
+/// evaluates the system while the observer runs, so the two borrows never
+/// meet; if they did, the evaluation would fail with an error, not a panic.
+struct Shared<'c, 's, S: ?Sized> {
+    cell: &'c RefCell<&'s mut S>,
+    dim: usize,
+}
+
+impl<'c, 's, S: ?Sized> Shared<'c, 's, S> {
+    fn system(&self) -> Result<std::cell::RefMut<'c, &'s mut S>, RhsError> {
+        self.cell
+            .try_borrow_mut()
+            .map_err(|_| RhsError::new("the system was evaluated while an output was recorded"))
+    }
+}
+
+impl<S: OdeSystem + ?Sized> OdeSystem for Shared<'_, '_, S> {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        self.system()?.rhs(t, y, dy)
+    }
+    fn step_accepted(&mut self, t: f64, y: &[f64]) -> Control {
+        match self.system() {
+            Ok(mut s) => s.step_accepted(t, y),
+            Err(_) => Control::Continue,
+        }
+    }
+}
+
+impl<S: SecondOrderSystem + ?Sized> SecondOrderSystem for Shared<'_, '_, S> {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    fn residual(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        r: &mut [f64],
+    ) -> Result<(), RhsError> {
+        self.system()?.residual(t, q, qd, qdd, r)
+    }
+    fn tangent(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        mass: &mut Mat<f64>,
+        damping: &mut Mat<f64>,
+        stiffness: &mut Mat<f64>,
+    ) -> Result<(), RhsError> {
+        self.system()?
+            .tangent(t, q, qd, qdd, mass, damping, stiffness)
+    }
+    fn step_accepted(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Control {
+        match self.system() {
+            Ok(mut s) => s.step_accepted(t, q, qd),
+            Err(_) => Control::Continue,
+        }
+    }
+}
+
 /// Integrates a first-order system y' = f(t, y) with one of the explicit
 /// integrators (Dopri5 or Adams) from (t0, y0) to the last output time of
-/// `opts`; `observer(t, y)` sees each output and may stop the run. Returns
-/// the integrator's statistics and whether the observer stopped it. Reduced
+/// `opts`; `observer(sys, t, y)` sees each output, with the system in the
+/// state of the integrator's last evaluation (e.g. to solve the output's
+/// configuration from there), and may stop the run. Returns the
+/// integrator's statistics and whether the observer stopped it. Reduced
 /// models use this exactly like the unreduced equations of motion.
 pub fn integrate_explicit<S: OdeSystem + ?Sized>(
     sys: &mut S,
     opts: &SimulationOptions,
     t0: f64,
     y0: &[f64],
-    mut observer: impl FnMut(f64, &[f64]) -> Control,
+    mut observer: impl FnMut(&mut S, f64, &[f64]) -> Control,
 ) -> Result<(Stats, bool), DynamicsError> {
     let t_end = *opts
         .output_times
@@ -147,6 +217,14 @@ pub fn integrate_explicit<S: OdeSystem + ?Sized>(
         .ok_or_else(|| DynamicsError::Invalid("no output times".into()))?;
     let out = Output::Times(opts.output_times.clone());
     let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(e.to_string());
+    let dim = sys.dim();
+    let cell = RefCell::new(sys);
+    let mut shared = Shared { cell: &cell, dim };
+    let mut observe = |t: f64, y: &[f64]| match cell.try_borrow_mut() {
+        Ok(mut s) => observer(&mut **s, t, y),
+        // (unreachable: the integrator is not evaluating the system)
+        Err(_) => Control::Stop,
+    };
     let sol = match opts.integrator {
         Integrator::Dopri5 => {
             let o = Dopri5Options {
@@ -155,7 +233,7 @@ pub fn integrate_explicit<S: OdeSystem + ?Sized>(
                 ..Default::default()
             };
             Dopri5::new(o)
-                .solve_with(sys, t0, y0, t_end, &out, &mut observer)
+                .solve_with(&mut shared, t0, y0, t_end, &out, &mut observe)
                 .map_err(to_err)?
         }
         Integrator::Adams => {
@@ -165,7 +243,7 @@ pub fn integrate_explicit<S: OdeSystem + ?Sized>(
                 ..Default::default()
             };
             Adams::new(o)
-                .solve_with(sys, t0, y0, t_end, &out, &mut observer)
+                .solve_with(&mut shared, t0, y0, t_end, &out, &mut observe)
                 .map_err(to_err)?
         }
         Integrator::GeneralizedAlpha => {
@@ -401,6 +479,26 @@ impl Dynamics {
         d
     }
 
+    /// The nodal coordinates x = F(q) at an output point (t, q) that the
+    /// integrator has reached, solved by a kinematics of their own that
+    /// starts from this dynamics' current configuration: the one of the
+    /// integrator's last evaluation, within a step of t. So the output lies
+    /// on the branch the integrator followed (a solve from a far-away
+    /// configuration, e.g. the end of the run, can land on a mirrored one),
+    /// and the integrator's own kinematics, and with it the run, is not
+    /// disturbed.
+    pub fn output_configuration(&mut self, t: f64, q: &[f64]) -> Result<Vec<f64>, DynamicsError> {
+        let mech = &self.mech;
+        let kin = self
+            .output_kin
+            .get_or_insert_with(|| flexmb_kinematics::Kinematics::new(mech.clone()));
+        kin.set_newton_options(self.kin.newton_options());
+        kin.set_guess(self.kin.x());
+        kin.solve(q, t)
+            .map_err(|e| DynamicsError::Kinematics { t, source: e })?;
+        Ok(kin.x().to_vec())
+    }
+
     /// Integrates from (t0, q0, q̇0) to the last output time. `observer(t, q, q̇)`
     /// is called at each output time and may stop the run (partial results
     /// are kept). See [`simulate_with`](Self::simulate_with).
@@ -547,7 +645,7 @@ impl Dynamics {
                     qdd: vec![0.0; n],
                     watch: Some(watch),
                 };
-                let run = integrate_explicit(&mut sys, opts, t0, &y0, |t: f64, y: &[f64]| {
+                let run = integrate_explicit(&mut sys, opts, t0, &y0, |_, t: f64, y: &[f64]| {
                     emit(t, &y[..n], &y[n..])
                 });
                 let watch = sys.watch.expect("set above");

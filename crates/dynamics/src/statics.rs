@@ -11,7 +11,10 @@ use flexmb_rotation::EulerParameters;
 /// Settings of the static solver.
 #[derive(Clone, Debug)]
 pub struct StaticOptions {
-    /// Initial number of load increments (halved adaptively on failure).
+    /// Number of equal load increments: the loads (and held values) go to
+    /// their full values in `load_steps` steps of 1/`load_steps`. A step
+    /// whose Newton iteration fails is halved (down to `min_increment`); after
+    /// a converged step the increment doubles again, up to 1/`load_steps`.
     pub load_steps: usize,
     /// Newton iterations per increment.
     pub max_iterations: usize,
@@ -63,6 +66,12 @@ pub(crate) struct StaticFactor {
 pub struct StaticSolution {
     /// The degrees of freedom.
     pub q: Vec<f64>,
+    /// The nodal coordinates x = F(q) of the equilibrium, the configuration
+    /// the solver converged to (solving F(q) again from another starting
+    /// guess, e.g. the reference configuration, can land on another branch).
+    pub x: Vec<f64>,
+    /// The deformations ε = D(x) there.
+    pub eps: Vec<f64>,
     /// Total Newton iterations.
     pub iterations: usize,
     /// Load increments used.
@@ -311,7 +320,8 @@ impl Dynamics {
         let held_start: Vec<f64> = opts.held.iter().map(|(i, _)| q0[*i]).collect();
         let free: Vec<usize> = (0..n_q).filter(|i| !held[*i]).collect();
         let mut lambda = 0.0;
-        let mut dl = 1.0 / opts.load_steps.max(1) as f64;
+        let max_dl = 1.0 / opts.load_steps.max(1) as f64;
+        let mut dl = max_dl;
         let mut iterations = 0;
         let mut increments = 0;
         let mut last_good = q.clone();
@@ -322,7 +332,7 @@ impl Dynamics {
         // the last converged increment (guesses for the kinematics after a
         // rejected iterate or increment)
         let mut dq_last = vec![0.0; free.len()];
-        let mut x_ok = self.mech.x0.clone();
+        let mut x_ok = self.kin.x().to_vec();
         let mut x_good = x_ok.clone();
         while lambda < 1.0 - 1e-15 {
             let target = (lambda + dl).min(1.0);
@@ -414,7 +424,7 @@ impl Dynamics {
                 increments += 1;
                 last_good.copy_from_slice(&q);
                 x_good.copy_from_slice(&x_ok);
-                dl = (dl * 2.0).min(1.0);
+                dl = (dl * 2.0).min(max_dl);
             } else {
                 // retry a smaller increment with a tangent at its start
                 force_refresh = true;
@@ -444,6 +454,8 @@ impl Dynamics {
         }
         let reactions = opts.held.iter().map(|(i, _)| g[*i]).collect();
         Ok(StaticSolution {
+            x: self.kin.x().to_vec(),
+            eps: self.kin.eps().to_vec(),
             q,
             iterations,
             increments,

@@ -134,8 +134,8 @@ fn work_balance(name: &str, t_end: f64) -> (f64, f64, f64) {
     );
     let rows: Vec<Vec<f64>> =
         tr.t.iter()
-            .zip(tr.q.iter().zip(&tr.qd))
-            .map(|(t, (q, qd))| table.row(&mut dy, *t, q, qd).unwrap())
+            .zip(tr.q.iter().zip(&tr.qd).zip(&tr.x))
+            .map(|(t, ((q, qd), x))| table.row(&mut dy, *t, q, qd, x).unwrap())
             .collect();
     let balance = |r: &Vec<f64>| r[k] + r[e] - r[w];
     let b0 = balance(&rows[0]);

@@ -73,13 +73,19 @@ pub struct FirstOrderView<'a> {
     pub e: &'a Mat<f64>,
 }
 
+/// A residual within this many ε·max|x| is at the rounding level of the
+/// coordinates it is computed from (a difference of two coordinates of size
+/// |x| carries an error of a few ε|x|; a deformation sums a few of them).
+const ROUNDING_RESIDUALS: f64 = 64.0;
+
 /// Newton settings of the position solve.
 #[derive(Clone, Copy, Debug)]
 pub struct NewtonOptions {
     /// Converged when every constraint residual |D_c(x) − target| ≤ `tol`·L,
     /// L the mean element length (residuals are lengths or dimensionless), or
     /// when the Newton update is at rounding level (≤ 8 ε max|x|) with the
-    /// residual below 1000·`tol`·L.
+    /// residual below 1000·`tol`·L or at the rounding level of the
+    /// coordinates (64 ε max|x|, x the dependent coordinates, at least 1).
     pub tol: f64,
     /// Iteration limit.
     pub max_iterations: usize,
@@ -98,7 +104,7 @@ impl Default for NewtonOptions {
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum KinematicsError {
     /// Newton did not converge.
-    #[error("the position solve did not converge in {iterations} iterations (residual {residual:.3e}); largest residuals: {equations:?}; largest last updates: {coordinates:?}. The configuration may be out of reach (a prescribed motion beyond the mechanism's range) or the step too large")]
+    #[error("the position solve did not converge in {iterations} iterations (residual {residual:.3e}); largest residuals: {equations:?}; largest last updates: {coordinates:?}. {hint}")]
     NotConverged {
         /// Iterations done.
         iterations: usize,
@@ -108,6 +114,8 @@ pub enum KinematicsError {
         equations: Vec<String>,
         /// Dependent coordinates with the largest last updates.
         coordinates: Vec<String>,
+        /// What may have caused it (a prescribed motion only where there is one).
+        hint: String,
     },
     /// The Jacobian of the constraints is singular at this configuration.
     #[error("singular kinematics at this configuration (pivot ratio {pivot_ratio:.1e}): the dependent coordinates {coordinates:?} are not determined by the equations: a singular position of the mechanism (e.g. a straightened toggle), a lost constraint, or a starting guess far from the solution (take smaller steps)")]
@@ -370,13 +378,14 @@ impl Kinematics {
         s
     }
 
+    /// The Newton settings of the position solve.
+    pub fn newton_options(&self) -> NewtonOptions {
+        self.opts
+    }
+
     /// Sets the Newton options.
     pub fn set_newton_options(&mut self, o: NewtonOptions) {
         self.opts = o;
-    }
-    /// The Newton options.
-    pub fn newton_options(&self) -> NewtonOptions {
-        self.opts
     }
     /// The mechanism.
     pub fn mechanism(&self) -> &Arc<Mechanism> {
@@ -746,10 +755,14 @@ impl Kinematics {
                 .dependent
                 .iter()
                 .fold(1.0f64, |m, &i| m.max(self.x[i].abs()));
+            // (the residual of a length cannot be computed more accurately than
+            // the rounding of the coordinates it is computed from: a mechanism
+            // far from the origin, or large against its elements, stalls
+            // there, however small tol · L is)
             let stalled = it > 0
                 && last_update.iter().fold(0.0f64, |m, v| m.max(v.abs()))
                     <= 8.0 * f64::EPSILON * x_scale
-                && res <= 1e3 * tol.max(1e-300);
+                && res <= (1e3 * tol).max(ROUNDING_RESIDUALS * f64::EPSILON * x_scale);
             if res <= tol || stalled {
                 outcome = Some(self.converged(it, mode));
                 break;
@@ -908,7 +921,13 @@ impl Kinematics {
             .collect();
         co.sort_by(|a, b| b.0.total_cmp(&a.0));
         let residual = eq.first().map_or(f64::NAN, |e| e.0);
+        let hint = if self.mech.inputs.is_empty() {
+            "The configuration may be out of reach of the degrees of freedom, or the starting configuration too far from it (take smaller steps)"
+        } else {
+            "The configuration may be out of reach (a prescribed motion beyond the mechanism's range) or the step too large"
+        };
         KinematicsError::NotConverged {
+            hint: hint.into(),
             iterations: self.opts.max_iterations,
             residual,
             equations: eq

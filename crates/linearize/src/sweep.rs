@@ -68,6 +68,9 @@ pub fn sweep(
     let mut dy = Dynamics::new(mech.clone());
     let mut q = mech.q0();
     let mut qs = Vec::with_capacity(n);
+    // the configuration of each equilibrium: the linearization's position
+    // solve starts there, not at the reference or at a neighbouring block
+    let mut xs = Vec::with_capacity(n);
     // phase 1: equilibria by continuation
     for (i, &s) in opts.values.iter().enumerate() {
         // the first equilibrium ramps the loads; the next ones continue from it
@@ -91,6 +94,7 @@ pub fn sweep(
                 })?;
         q = sol.q;
         qs.push(q.clone());
+        xs.push(sol.x);
         progress(i + 1, total);
     }
     // phase 2: linearization and eigen analysis in parallel
@@ -118,6 +122,7 @@ pub fn sweep(
                 .map(|(j, q)| {
                     let i = c * chunk + j;
                     dy.set_load_scale(scale[i]);
+                    dy.kinematics_mut().set_guess(&xs[i]);
                     let lin = dy.linearize_at_rest(opts.t, q).map_err(|e| {
                         LinearizeError::Equilibrium {
                             s: opts.values[i],

@@ -46,7 +46,7 @@ pub use basis::{
     fixed_basis_frequencies, modal_basis, per_mode_svd_basis, svd_modal_basis, Basis, FixedBasis,
     PerModeSvd, SvdModal, FINAL_SVD_THRESHOLD, SVD_THRESHOLD,
 };
-pub use continuation::{continue_load_scale, load_scale_path, SUBSTEPS};
+pub use continuation::{continue_load_scale, load_scale_path, ReducedEquilibrium, SUBSTEPS};
 pub use ibm::{interpolated_basis_from_sweep, InterpolatedBasis, Knots, SubspaceInterpolation};
 pub use model::{ReducedLinearization, ReducedModel, ReducedTrajectory};
 pub use msi::{largest_principal_angle, mac_sorted, modal_subspace_interpolation, orthonormalize};

@@ -398,6 +398,10 @@ pub struct ReducedTrajectory {
     pub z: Vec<Vec<f64>>,
     /// ż at each output time.
     pub zd: Vec<Vec<f64>>,
+    /// The unreduced nodal coordinates x = F(G(z)) at each output time,
+    /// solved when the integrator reached the output from the configuration
+    /// of its last evaluation ([`Dynamics::output_configuration`]).
+    pub x: Vec<Vec<f64>>,
     /// Integrator statistics (exact evaluation counts).
     pub stats: flexmb_ode::Stats,
     /// Wall time of the integration in seconds.
@@ -409,7 +413,8 @@ pub struct ReducedTrajectory {
 impl ReducedModel {
     /// Integrates the reduced equations of motion (6.15) from (t0, z0, ż0)
     /// with an explicit integrator (the thesis's choice for reduced models);
-    /// `observer(t, z, ż)` may stop the run.
+    /// `observer(t, z, ż)` may stop the run. The trajectory holds each
+    /// output's configuration, solved along the run.
     pub fn simulate(
         &mut self,
         t0: f64,
@@ -428,19 +433,37 @@ impl ReducedModel {
         }
         let mut y0 = z0.to_vec();
         y0.extend_from_slice(zd0);
-        let (mut t, mut z, mut zd) = (vec![], vec![], vec![]);
+        let (mut t, mut z, mut zd, mut x) = (vec![], vec![], vec![], vec![]);
+        let mut failure = None;
         let start = std::time::Instant::now();
-        let (stats, stopped) =
-            flexmb_dynamics::integrate_explicit(self, opts, t0, &y0, |tt: f64, y: &[f64]| {
+        let (stats, stopped) = flexmb_dynamics::integrate_explicit(
+            self,
+            opts,
+            t0,
+            &y0,
+            |m: &mut Self, tt: f64, y: &[f64]| {
+                let q = m.full_coordinates(&y[..n]);
+                match m.dy.output_configuration(tt, &q) {
+                    Ok(xt) => x.push(xt),
+                    Err(e) => {
+                        failure = Some(e);
+                        return flexmb_dynamics::Control::Stop;
+                    }
+                }
                 t.push(tt);
                 z.push(y[..n].to_vec());
                 zd.push(y[n..].to_vec());
                 observer(tt, &y[..n], &y[n..])
-            })?;
+            },
+        )?;
+        if let Some(e) = failure {
+            return Err(e.into());
+        }
         Ok(ReducedTrajectory {
             t,
             z,
             zd,
+            x,
             stats,
             wall_time: start.elapsed().as_secs_f64(),
             stopped,
