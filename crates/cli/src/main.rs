@@ -11,11 +11,14 @@ mod reduced;
 mod report;
 
 use clap::{Args, Parser, Subcommand};
-use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions, StaticOptions};
+use flexmb_dynamics::{
+    Control, Dynamics, Integrator, OutputTable, SimulationOptions, StaticOptions,
+};
 use flexmb_model::Scene;
 use flexmb_plot::write_csv;
 use report::{
-    count_bar, linspace, time_bar, write_frequency_sweep, write_outputs, FrequencySweep, Response,
+    count_bar, linspace, time_bar, write_frequency_sweep, write_outputs, FrequencySweep,
+    OutputRows, Response,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -342,13 +345,14 @@ fn simulate(a: &SimulateArgs, interrupted: &Arc<AtomicBool>) -> Result<(), Failu
     let result = match &a.reduced {
         None => {
             println!("{}", mech.summary());
-            simulate_unreduced(&mut dy, &opts, a.static_first, observer).map(|r| (r, None))
+            simulate_unreduced(&mut dy, &opts, a.static_first, observer)
+                .map(|(r, rows)| (r, None, Some(rows)))
         }
         Some(model) => reduced::simulate(&mech, model, &opts, a.static_first, observer)
-            .map(|(r, d)| (r, Some(d))),
+            .map(|(r, d)| (r, Some(d), None)),
     };
     pb.finish_and_clear();
-    let (response, model) = result?;
+    let (response, model, rows) = result?;
     println!("{}", report::summary(&response));
     let mut comments = vec![format!("flexmb simulate {}", a.scene.display())];
     if let (Some(m), Some(d)) = (&a.reduced, &model) {
@@ -358,7 +362,7 @@ fn simulate(a: &SimulateArgs, interrupted: &Arc<AtomicBool>) -> Result<(), Failu
         "integrator {integrator:?}, rtol {:e}, atol {:e}, {} function evaluations",
         a.rtol, a.atol, response.stats.rhs_evals
     ));
-    write_outputs(&mut dy, &response, &comments, &a.out)?;
+    write_outputs(&mut dy, &response, rows, &comments, &a.out)?;
     if response.stopped {
         return Err(Failure::Interrupted);
     }
@@ -372,7 +376,7 @@ fn simulate_unreduced(
     opts: &SimulationOptions,
     static_first: bool,
     mut observer: impl FnMut(f64) -> Control,
-) -> Result<Response, Failure> {
+) -> Result<(Response, OutputRows), Failure> {
     let mut q0 = dy.mechanism().q0();
     if static_first {
         q0 = dy
@@ -383,8 +387,32 @@ fn simulate_unreduced(
     let qd0 = dy
         .initial_qd(0.0, &q0)
         .map_err(|e| Failure::Compute(e.to_string()))?;
-    dy.simulate(0.0, &q0, &qd0, opts, |t, _, _| observer(t))
-        .map_err(|e| Failure::Compute(e.to_string()))
+    // the output rows, evaluated when the integrator reaches each output, in
+    // the chart of the orientations the run has there
+    let table = OutputTable::new(dy).map_err(|e| Failure::Input(e.to_string()))?;
+    let mut rows = vec![];
+    let mut failure = None;
+    let traj = dy
+        .simulate_with(0.0, &q0, &qd0, opts, |p| {
+            let x = p.dynamics.kinematics().x().to_vec();
+            match table.row(p.dynamics, p.t, p.q_chart, p.qd_chart, &x) {
+                Ok(r) => {
+                    let mut row = vec![p.t];
+                    row.extend(r);
+                    rows.push(row);
+                    observer(p.t)
+                }
+                Err(e) => {
+                    failure = Some(e);
+                    Control::Stop
+                }
+            }
+        })
+        .map_err(|e| Failure::Compute(e.to_string()))?;
+    if let Some(e) = failure {
+        return Err(Failure::Compute(e.to_string()));
+    }
+    Ok((traj, rows))
 }
 
 fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), Failure> {

@@ -902,3 +902,85 @@ fn static_writes_the_equilibrium_it_found() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A free body through more than one turn (chart switches of its Euler
+/// parameters) through the command line: the outputs are written in every
+/// chart, the body's centre stays at rest and the energy stays constant (the
+/// beam with a plate at its middle of issue 13, item 1, for 1.2 s ≈ 1.15
+/// turns).
+#[test]
+fn simulate_a_free_body_through_more_than_a_turn() {
+    let dir = temp_dir("free-body");
+    let scene = dir.join("plate.ron");
+    std::fs::write(
+        &scene,
+        r#"(
+        dimension: Spatial,
+        materials: { "polymer": (e: 5.0e8, nu: 0.35, rho: 1200.0) },
+        sections: { "bar": Rectangle(by: 0.02, bz: 0.005) },
+        nodes: [ (id: "A", at: [-0.3, 0.0, 0.0]), (id: "B", at: [0.3, 0.0, 0.0]) ],
+        elements: [
+            (id: "beam", type: Beam((nodes: ("A", "B"), material: "polymer", section: "bar", up: Some([0.0, 1.0, 0.0]), n: 2))),
+            (id: "plate", type: RigidBody(node: "beam.n1", mass: 0.05, inertia: [[1.0e-3, 0.0, 0.0], [0.0, 0.6e-3, 0.0], [0.0, 0.0, 1.6e-3]])),
+        ],
+        rigid: [ Def("beam", "elongation"), Def("beam", "torsion") ],
+        initial_velocity: [ (omega: Some([0.06, 6.0, 0.06]), about: Some([0.0, 0.0, 0.0])) ],
+        outputs: [Position("beam.n1"), Position("B"), Energies],
+    )"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let args = [
+        "simulate",
+        scene.to_str().unwrap(),
+        "--t-end",
+        "1.2",
+        "--outputs",
+        "25",
+        "--rtol",
+        "1e-10",
+        "--atol",
+        "1e-12",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let o = run(&args);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}: {stdout}{}",
+        line(&args),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("chart switches"), "{stdout}");
+    let (h, rows) = flexmb_plot_read(&out.join("outputs.csv"));
+    let col = |name: &str| {
+        h.iter()
+            .position(|c| c == name)
+            .unwrap_or_else(|| panic!("{name} in {h:?}"))
+    };
+    let (cx, cz, bx, kin) = (
+        col("beam.n1.x"),
+        col("beam.n1.z"),
+        col("B.x"),
+        col("kinetic"),
+    );
+    let t0 = rows[0][kin];
+    assert!((t0 - 0.0496913).abs() < 1e-6, "T0 = {t0}");
+    let mut min_bx = f64::MAX;
+    for r in &rows {
+        assert!(
+            r[cx].abs() < 1e-9 && r[cz].abs() < 1e-9,
+            "the centre moved: {r:?}"
+        );
+        assert!(
+            (r[kin] + r[col("elastic")] - t0).abs() < 1e-9 * t0,
+            "energy drifts: {r:?}"
+        );
+        min_bx = min_bx.min(r[bx]);
+    }
+    // B went around: through x = −0.3 m (half a turn)
+    assert!(min_bx < -0.29, "B.x never below {min_bx}");
+    std::fs::remove_dir_all(&dir).ok();
+}

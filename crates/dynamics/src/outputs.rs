@@ -2,7 +2,7 @@
 //! stress resultants, energies, DOFs), as named columns of a table.
 
 use crate::{Dynamics, DynamicsError};
-use flexmb_model::OutputSpec;
+use flexmb_model::{Coordinate, OutputSpec};
 use flexmb_rotation::EulerParameters;
 
 enum Column {
@@ -25,6 +25,10 @@ pub struct OutputTable {
     /// (t, external power, external work) of the previous row: the work is
     /// the trapezoidal integral of the power over the rows.
     work: std::cell::Cell<Option<(f64, f64, f64)>>,
+    /// The DOFs of the mechanism the table was made for: `Dofs` columns are
+    /// read from x and ε, so a row is the same in any chart of the
+    /// orientations (a dynamics whose free nodes switched charts).
+    dofs: Vec<Coordinate>,
 }
 
 impl OutputTable {
@@ -125,10 +129,12 @@ impl OutputTable {
             columns,
             header,
             work: std::cell::Cell::new(None),
+            dofs: m.dofs.clone(),
         })
     }
 
-    /// One row at (t, q, q̇), with `x` the configuration of the trajectory at
+    /// One row at (t, q, q̇) (q and q̇ of `dy`'s chart, which may differ from
+    /// the table's, see [`Dynamics::simulate_with`]), with `x` the configuration of the trajectory at
     /// that point ([`Trajectory::x`](crate::Trajectory::x)): the position
     /// solve starts there, so that the row is on the branch of the motion
     /// and does not depend on what `dy` solved before (e.g. the end of a
@@ -195,7 +201,10 @@ impl OutputTable {
                 Column::Elastic => en.map_or(0.0, |e| e.elastic),
                 Column::Gravitational => en.map_or(0.0, |e| e.gravitational),
                 Column::ExternalWork => work,
-                Column::Q(k) => q[*k],
+                Column::Q(k) => match self.dofs[*k] {
+                    Coordinate::Node(i) => x[i],
+                    Coordinate::Def(j) => eps[j],
+                },
             })
             .collect())
     }

@@ -405,8 +405,16 @@ fn a_rigid_body_inertia_no_body_can_have_is_refused() {
     )"#
         )
     };
-    let e = err(&scene("[[1.0e-3, 0.0, 0.0], [0.0, 1.0e-3, 0.0], [0.0, 0.0, 3.0e-3]]"));
-    assert!(e.contains("plate") && e.contains("triangle inequality"), "{e}");
+    let e = err(&scene(
+        "[[1.0e-3, 0.0, 0.0], [0.0, 1.0e-3, 0.0], [0.0, 0.0, 3.0e-3]]",
+    ));
+    assert!(
+        e.contains("plate") && e.contains("triangle inequality"),
+        "{e}"
+    );
     let flat = "[[1.0e-3, 0.0, 0.0], [0.0, 0.6e-3, 0.0], [0.0, 0.0, 1.6e-3]]";
-    Scene::from_ron_str(&scene(flat)).unwrap().build(None).unwrap();
+    Scene::from_ron_str(&scene(flat))
+        .unwrap()
+        .build(None)
+        .unwrap();
 }
