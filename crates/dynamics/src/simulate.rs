@@ -269,6 +269,11 @@ fn to_rhs_error(e: DynamicsError) -> RhsError {
     }
 }
 
+/// Values of the DOFs (or their rates).
+type Q = Vec<f64>;
+/// A state (t, q, q̇) of a run.
+type StateAt = (f64, Q, Q);
+
 /// What a segment of a charted run needs between steps: the chart checks
 /// and the configuration of the last accepted step (the warm start of the
 /// output evaluations).
@@ -278,7 +283,7 @@ struct StepWatch {
     /// x at the last accepted step.
     x: Rc<RefCell<Vec<f64>>>,
     /// (t, q, q̇) where a chart must switch.
-    switch_at: Option<(f64, Vec<f64>, Vec<f64>)>,
+    switch_at: Option<StateAt>,
     /// The last evaluation that failed recoverably (the integrator retried
     /// with a smaller step): the reason to give if the run fails after it.
     last_failure: Option<(f64, String)>,
@@ -603,7 +608,7 @@ impl Dynamics {
         start_mech: &Arc<Mechanism>,
         traj: &mut Trajectory,
         observer: &mut impl FnMut(&mut OutputPoint<'_>) -> Control,
-    ) -> Result<(Stats, Option<(f64, Vec<f64>, Vec<f64>)>, bool), DynamicsError> {
+    ) -> Result<(Stats, Option<StateAt>, bool), DynamicsError> {
         let n = self.n_q();
         let t_end = *opts.output_times.last().expect("output times");
         let out = Output::Times(opts.output_times.clone());
@@ -707,7 +712,7 @@ impl Dynamics {
         q: &[f64],
         qd: &[f64],
         log: &mut Vec<ChartSwitch>,
-    ) -> Result<Option<(Vec<f64>, Vec<f64>)>, DynamicsError> {
+    ) -> Result<Option<(Q, Q)>, DynamicsError> {
         let charts = self.mech.euler_charts();
         let wanted: Vec<_> = charts
             .iter()
