@@ -183,3 +183,39 @@ fn malformed_ron_reports_line_and_column() {
     }
     assert!(e.to_string().contains("line 3, column"), "{e}");
 }
+
+#[test]
+fn a_chain_too_long_is_refused_before_anything_is_allocated() {
+    let e = err(&variant(
+        r#"section: "bar"))),
+        (id: "bc""#,
+        r#"section: "bar", n: 2000000))),
+        (id: "bc""#,
+    ));
+    assert!(
+        e.contains("element 'ab'") && e.contains("n = 2000000") && e.contains("1000000"),
+        "{e}"
+    );
+    // 1e9 is not an integer: a parse error with its place, not an allocation
+    let e = err(&variant(
+        r#"section: "bar"))),
+        (id: "bc""#,
+        r#"section: "bar", n: 1e9))),
+        (id: "bc""#,
+    ));
+    assert!(e.contains("line 7") && e.contains("integer"), "{e}");
+    // large but allowed: assembled in well under a second
+    let t = std::time::Instant::now();
+    let m = Scene::from_ron_str(&variant(
+        r#"section: "bar"))),
+        (id: "bc""#,
+        r#"section: "bar", n: 2000))),
+        (id: "bc""#,
+    ))
+    .unwrap()
+    .build(None)
+    .unwrap();
+    // two bending deformations per beam of the chain, two of bc
+    assert_eq!(m.n_dof(), 2 * 2000 + 2);
+    assert!(t.elapsed().as_secs_f64() < 10.0, "{:?}", t.elapsed());
+}
