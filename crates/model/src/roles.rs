@@ -1170,8 +1170,19 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
     }
     let forced = METHOD.with(|m| m.get()) == Method::Sparse;
     if method == Method::Sparse && (nd > DENSE_MAX_DEPENDENT || forced) {
-        let dep_rows: Vec<Vec<(usize, f64)>> = mech
+        // in the greedy's order (equations, then the chosen deformations), in
+        // which the blocks stay small
+        let mut order: Vec<usize> = mech
             .constraint_rows
+            .iter()
+            .copied()
+            .filter(|j| !matches!(mech.e_roles[*j], ERole::Dof(_)))
+            .collect();
+        order.extend(mech.dofs.iter().filter_map(|c| match c {
+            Coordinate::Def(j) => Some(*j),
+            Coordinate::Node(_) => None,
+        }));
+        let dep_rows: Vec<Vec<(usize, f64)>> = order
             .iter()
             .map(|j| {
                 rows[*j]
