@@ -228,6 +228,7 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
     let mut element_ids = HashMap::new();
     let mut mode_groups: Vec<(String, usize)> = vec![];
     let mut part_axes: HashMap<String, PartAxis> = HashMap::new();
+    let mut chain_total = 0usize;
     for entry in &scene.elements {
         let id = entry.id.clone();
         if element_ids.insert(id.clone(), ()).is_some() {
@@ -241,8 +242,28 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
             id: id.clone(),
             source: e,
         };
-        if chain_n(&entry.kind) == 0 {
+        let n = chain_n(&entry.kind);
+        if n == 0 {
             return Err(ModelError::invalid(ctx, "n must be at least 1"));
+        }
+        if n > MAX_CHAIN_N {
+            return Err(ModelError::invalid(
+                ctx,
+                format!(
+                    "n = {n} elements in one chain is more than the {MAX_CHAIN_N} the chain helper allows"
+                ),
+            ));
+        }
+        chain_total += n;
+        let estimate = chain_total as f64 * BYTES_PER_ELEMENT;
+        if estimate > crate::roles::physical_memory() as f64 / 4.0 {
+            return Err(ModelError::TooLarge {
+                what: format!(
+                    "{ctx}: {chain_total} elements would need about {} to assemble",
+                    crate::roles::human_bytes(estimate)
+                ),
+                limit: crate::roles::human_bytes(crate::roles::physical_memory() as f64 / 4.0),
+            });
         }
         match &entry.kind {
             ElementSpec::Beam(b) => {
@@ -783,6 +804,13 @@ pub(crate) fn opt_vec3(
         None => Ok([0.0; 3]),
     }
 }
+
+/// The most elements one chain helper may make.
+pub(crate) const MAX_CHAIN_N: usize = 1_000_000;
+
+/// Memory per element of an assembled mechanism, measured on a spatial beam
+/// chain (element data, names, sparse Jacobian rows, role bookkeeping), with a margin.
+const BYTES_PER_ELEMENT: f64 = 20e3;
 
 fn chain_n(k: &ElementSpec) -> usize {
     match k {

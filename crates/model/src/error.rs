@@ -82,6 +82,14 @@ pub enum ModelError {
         /// Names of the coordinates taking part in them.
         undetermined: Vec<String>,
     },
+    /// A dense matrix or a model too large for this machine.
+    #[error("{what}, more than a quarter of this machine's memory ({limit}); make the model smaller (fewer chain elements `n`) or split it")]
+    TooLarge {
+        /// What would be allocated, with its size.
+        what: String,
+        /// The limit.
+        limit: String,
+    },
 }
 
 impl ModelError {

@@ -418,3 +418,37 @@ fn a_rigid_body_inertia_no_body_can_have_is_refused() {
         .build(None)
         .unwrap();
 }
+
+#[test]
+fn a_chain_too_long_is_refused_before_anything_is_allocated() {
+    let e = err(&variant(
+        r#"section: "bar"))),
+        (id: "bc""#,
+        r#"section: "bar", n: 2000000))),
+        (id: "bc""#,
+    ));
+    assert!(
+        e.contains("element 'ab'") && e.contains("n = 2000000") && e.contains("1000000"),
+        "{e}"
+    );
+    // 1e9 is not an integer: a parse error with its place, not an allocation
+    let e = err(&variant(
+        r#"section: "bar"))),
+        (id: "bc""#,
+        r#"section: "bar", n: 1e9))),
+        (id: "bc""#,
+    ));
+    assert!(e.contains("line 7") && e.contains("integer"), "{e}");
+    // large but allowed (its assembly time is in benches/build.rs)
+    let m = Scene::from_ron_str(&variant(
+        r#"section: "bar"))),
+        (id: "bc""#,
+        r#"section: "bar", n: 2000))),
+        (id: "bc""#,
+    ))
+    .unwrap()
+    .build(None)
+    .unwrap();
+    // two bending deformations per beam of the chain, two of bc
+    assert_eq!(m.n_dof(), 2 * 2000 + 2);
+}
