@@ -347,3 +347,33 @@ fn free_beam_with_plate_conserves_energy_and_momentum() {
     );
     assert_conserved(&samples, 1e-7, "beam + plate");
 }
+
+/// A point mass on its own free node in the same general rigid field: its
+/// share of T0 is ½ m |v + ω × (r − a)|² (T0 of the whole scene minus the
+/// body's closed form), to 1e-12.
+#[test]
+fn initial_kinetic_energy_of_a_point_mass_in_a_general_field() {
+    let (v, omega, about) = ([0.3, -0.2, 0.5], [0.7, 2.0, -1.3], [0.0, 0.1, 0.0]);
+    let scene = Scene::from_ron_str(
+        r#"(
+        dimension: Spatial,
+        nodes: [ (id: "P", at: [0.4, 0.2, -0.3]) ],
+        elements: [ (id: "m", type: PointMass(node: "P", mass: 1.5)) ],
+        initial_velocity: [ (v: Some([0.3, -0.2, 0.5]), omega: Some([0.7, 2.0, -1.3]), about: Some([0.0, 0.1, 0.0])) ],
+    )"#,
+    )
+    .unwrap();
+    let mech = Arc::new(scene.build(None).unwrap());
+    let mut dy = Dynamics::new(mech.clone());
+    let q0 = mech.q0();
+    let qd0 = dy.initial_qd(0.0, &q0).unwrap();
+    let t = dy.energies(0.0, &q0, &qd0).unwrap().kinetic;
+    let r = [0.4 - about[0], 0.2 - about[1], -0.3 - about[2]];
+    let w = cross(&omega, &r);
+    let vp = [v[0] + w[0], v[1] + w[1], v[2] + w[2]];
+    let expected = 0.5 * 1.5 * dot(&vp, &vp);
+    assert!(
+        (t - expected).abs() <= 1e-12 * expected,
+        "T = {t:e}, expected {expected:e}"
+    );
+}
