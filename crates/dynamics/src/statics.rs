@@ -49,9 +49,27 @@ impl Default for StaticOptions {
 /// factor; otherwise the tangent is rebuilt at the current iterate.
 const CHORD_CONTRACTION: f64 = 0.2;
 
-/// Halvings of a Newton update whose iterate flips an element before the
-/// load increment is cut instead.
+/// Halvings of a Newton update whose iterate flips an element, or raises
+/// the out-of-balance, before the load increment is cut instead.
 const MAX_FLIP_HALVINGS: usize = 10;
+
+/// Steps up to this multiple of the convergence tolerance on q are at the
+/// round-off level of the out-of-balance and exempt from the residual guard
+/// of [`Dynamics::static_equilibrium`].
+const RESIDUAL_GUARD_FLOOR: f64 = 1e4;
+
+/// Rejections by the residual guard per load increment, after which the
+/// increment goes on with plain (chord) Newton.
+const RESIDUAL_GUARD_BUDGET: usize = 12;
+
+/// Takes back the fraction `part` of the last update `dq` of the free DOFs
+/// (1: all of it, 0.5: halve it) and keeps what remains in `dq`.
+fn retract(q: &mut [f64], free: &[usize], dq: &mut [f64], part: f64) {
+    for (d, i) in dq.iter_mut().zip(free) {
+        q[*i] -= part * *d;
+        *d *= 1.0 - part;
+    }
+}
 
 /// The factorized static tangent kept between Newton iterations (and between
 /// calls, e.g. along a sweep) for chord steps.
@@ -59,6 +77,13 @@ pub(crate) struct StaticFactor {
     lu: DenseLu,
     /// The free (not held) DOFs it was built for.
     free: Vec<usize>,
+    /// The tangent's coupling K_fh of the free to the held DOFs (column k
+    /// for the k-th held DOF, n_free rows each), for the predictor
+    /// [`Dynamics::predict_free`].
+    coupling: Vec<f64>,
+    /// 1/|K_ii| of the free DOFs, the weights of the residual guard's
+    /// energy-scaled out-of-balance Σ g_i²/|K_ii|.
+    weights: Vec<f64>,
 }
 
 /// An equilibrium.
@@ -216,18 +241,28 @@ impl Dynamics {
     }
 
     /// F,qᵀ (∂f/∂x) F,q for position-dependent loads (consistent gravity on
-    /// rotating elements, moments on Euler parameters).
+    /// rotating elements, moments on Euler parameters): the element blocks
+    /// of ∂f/∂x are accumulated into D F,q (only the rows of loaded
+    /// coordinates are non-zero), then one product F,qᵀ (D F,q), instead of
+    /// a dense n_q × n_q product per element.
     pub(crate) fn load_stiffness(&mut self, t: f64) -> Mat<f64> {
         let mech = &self.mech;
         let n_q = mech.n_dof();
         let view = self.kin.first_order_view();
         let (f, x) = (view.f, view.x);
-        let mut l = Mat::<f64>::zeros(n_q, n_q);
+        let mut df = Mat::<f64>::zeros(f.nrows(), n_q);
+        let mut loaded = false;
+        // D F,q += P_eᵀ D_e P_e F,q for one element block D_e (row-major n × n)
         let mut add = |idx: &[usize], d: &[f64], n: usize| {
-            let fe = Mat::from_fn(n, n_q, |a, c| f[(idx[a], c)]);
-            let de = Mat::from_fn(n, n, |a, b| d[a * n + b]);
-            let df = &de * &fe;
-            l += fe.transpose() * df;
+            loaded = true;
+            for col in 0..n_q {
+                let fcol = f.col_as_slice(col);
+                let dcol = df.col_as_slice_mut(col);
+                for a in 0..n {
+                    let v: f64 = (0..n).map(|b| d[a * n + b] * fcol[idx[b]]).sum();
+                    dcol[idx[a]] += v;
+                }
+            }
         };
         if let Some(g0) = mech.gravity {
             let g = g0.map(|v| v * self.load_factor);
@@ -265,7 +300,10 @@ impl Dynamics {
                 add(index, &d, 4);
             }
         }
-        l
+        if !loaded {
+            return Mat::zeros(n_q, n_q);
+        }
+        f.transpose() * &df
     }
 
     /// The tangent at q, factorized over the free DOFs and kept for chord
@@ -275,6 +313,7 @@ impl Dynamics {
         t: f64,
         q: &[f64],
         free: &[usize],
+        held: &[(usize, f64)],
         load_factor: f64,
     ) -> Result<Vec<f64>, DynamicsError> {
         self.static_factor = None;
@@ -284,15 +323,71 @@ impl Dynamics {
         if !lu.factor(tf.as_ref()) {
             return Err(DynamicsError::SingularTangent { load_factor });
         }
+        let coupling = held
+            .iter()
+            .flat_map(|&(h, _)| free.iter().map(move |&a| (a, h)))
+            .map(|(a, h)| tan[(a, h)])
+            .collect();
+        let diag_max = free.iter().fold(0.0f64, |m, &a| m.max(tan[(a, a)].abs()));
+        let weights = free
+            .iter()
+            .map(|&a| {
+                1.0 / tan[(a, a)]
+                    .abs()
+                    .max(1e-12 * diag_max)
+                    .max(f64::MIN_POSITIVE)
+            })
+            .collect();
         self.static_factor = Some(StaticFactor {
             lu,
             free: free.to_vec(),
+            coupling,
+            weights,
         });
         Ok(g)
     }
 
+    /// The first-order (Euler) predictor of a continuation in the held
+    /// values: when the held DOFs move by Δh, the free ones follow
+    /// Δq_f = −K_ff⁻¹ K_fh Δh (the tangent (E.6) of the last equilibrium,
+    /// or of its last chord iterate), so that Newton starts O(Δh²) from the
+    /// new equilibrium instead of O(Δh). Without it, a held coordinate that
+    /// moves alone strains the loop-closure deformations by O(Δh) and Newton
+    /// wanders for tens of iterations (issue 14 item 7: with gravity the
+    /// sweep over S.x of the spatial guidance took 10× as long as without).
+    /// Does nothing without a factor for these free DOFs.
+    fn predict_free(&self, q: &mut [f64], free: &[usize], dh: &[f64]) {
+        let Some(f) = &self.static_factor else {
+            return;
+        };
+        let nf = free.len();
+        if f.free != free || f.coupling.len() != nf * dh.len() || dh.iter().all(|d| *d == 0.0) {
+            return;
+        }
+        let mut rhs = vec![0.0; nf];
+        for (k, d) in dh.iter().enumerate() {
+            for (r, c) in rhs.iter_mut().zip(&f.coupling[k * nf..(k + 1) * nf]) {
+                *r -= c * d;
+            }
+        }
+        f.lu.solve_vec(&mut rhs, &mut Mat::zeros(nf, 1));
+        if rhs.iter().all(|v| v.is_finite()) {
+            for (i, d) in free.iter().zip(&rhs) {
+                q[*i] += d;
+            }
+        }
+    }
+
     /// Static equilibrium at time `t` (inputs at their values at t), starting
     /// from `q0`, with load increments and held degrees of freedom.
+    ///
+    /// Each increment of held values starts from the first-order predictor
+    /// Δq_f = −K_ff⁻¹ K_fh Δh with the tangent at its start, and each
+    /// Newton step must lower the energy-scaled out-of-balance Σ g_i²/|K_ii|
+    /// or is halved (a chord step is retried with a fresh tangent), at most
+    /// 12 times per increment; then plain Newton goes on. Together they made
+    /// the held sweep of the spatial guidance under gravity 15–100× faster
+    /// (issue 14 item 7, `tests/held_sweep.rs`).
     ///
     /// Stays on the physical branch: an iterate at which an element has
     /// flipped ([`flexmb_element::Element::is_flipped`]: its chord turned by
@@ -332,18 +427,42 @@ impl Dynamics {
         // the last converged increment (guesses for the kinematics after a
         // rejected iterate or increment)
         let mut dq_last = vec![0.0; free.len()];
+        let mut dh = vec![0.0; opts.held.len()];
         let mut x_ok = self.kin.x().to_vec();
         let mut x_good = x_ok.clone();
         while lambda < 1.0 - 1e-15 {
             let target = (lambda + dl).min(1.0);
             self.load_factor = if opts.ramp_loads { target } else { 1.0 };
             for (k, &(i, v)) in opts.held.iter().enumerate() {
-                q[i] = held_start[k] + target * (v - held_start[k]);
+                let value = held_start[k] + target * (v - held_start[k]);
+                dh[k] = value - q[i];
+                q[i] = value;
+            }
+            if dh.iter().any(|d| *d != 0.0) {
+                let mut q_start = q.clone();
+                for (k, &(i, _)) in opts.held.iter().enumerate() {
+                    q_start[i] -= dh[k];
+                }
+                if self
+                    .refresh_static_factor(t, &q_start, &free, &opts.held, target)
+                    .is_ok()
+                {
+                    self.predict_free(&mut q, &free, &dh);
+                }
             }
             let mut converged = false;
             let mut prev_dn = f64::INFINITY;
             let mut steps = 0;
             let mut halvings = 0;
+            // the residual guard: the out-of-balance ‖g_f‖₂ at the iterate the
+            // last step was taken from, whether that step was a chord step,
+            // and the configuration there
+            let mut g_from = f64::INFINITY;
+            // in a narrow curved valley of the out-of-balance the halved
+            // steps creep: after this many rejections per increment the
+            // guard gives way to plain Newton
+            let mut guard_budget = RESIDUAL_GUARD_BUDGET;
+            let mut last_was_chord = false;
             while steps < opts.max_iterations {
                 iterations += 1;
                 // chord Newton: keep the factorized tangent (of an earlier
@@ -353,7 +472,7 @@ impl Dynamics {
                 let refreshed =
                     force_refresh || self.static_factor.as_ref().is_none_or(|f| f.free != free);
                 let evaluated = if refreshed {
-                    self.refresh_static_factor(t, &q, &free, target)
+                    self.refresh_static_factor(t, &q, &free, &opts.held, target)
                 } else {
                     self.static_residual(t, &q)
                 };
@@ -379,13 +498,57 @@ impl Dynamics {
                         break;
                     }
                     halvings += 1;
-                    for (k, i) in free.iter().enumerate() {
-                        dq_last[k] *= 0.5;
-                        q[*i] -= dq_last[k];
-                    }
+                    retract(&mut q, &free, &mut dq_last, 0.5);
                     self.kin.set_guess(&x_ok);
                     force_refresh = true;
                     continue;
+                }
+                // the residual guard: a step that raised the out-of-balance
+                // left Newton's region of convergence (the torsion of sheet
+                // flexures under gravity couples to their stiff bending: one
+                // full step can raise it 100-fold and Newton then wandered
+                // for tens of iterations). The out-of-balance is measured
+                // as Σ g_i²/|K_ii|, an energy, so that stiff elongations do
+                // not outweigh soft torsions. A chord step that raised it is
+                // undone and retried with a fresh tangent; a Newton step is
+                // halved (a NaN counts as raised). Steps at the round-off
+                // level of q are exempt.
+                let gn = match &self.static_factor {
+                    Some(f) if f.free == free => free
+                        .iter()
+                        .zip(&f.weights)
+                        .map(|(i, w)| g[*i] * g[*i] * w)
+                        .sum::<f64>(),
+                    _ => f64::INFINITY,
+                };
+                let qn = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let last_dn = dq_last.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                if steps > 0
+                    && guard_budget > 0
+                    && !matches!(
+                        gn.partial_cmp(&g_from),
+                        Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+                    )
+                    && last_dn > RESIDUAL_GUARD_FLOOR * opts.tol * (1.0 + qn)
+                {
+                    guard_budget -= 1;
+                    if last_was_chord {
+                        retract(&mut q, &free, &mut dq_last, 1.0);
+                        last_was_chord = false;
+                        steps -= 1;
+                        prev_dn = f64::INFINITY;
+                        self.kin.set_guess(&x_ok);
+                        force_refresh = true;
+                        continue;
+                    }
+                    if halvings < MAX_FLIP_HALVINGS {
+                        halvings += 1;
+                        retract(&mut q, &free, &mut dq_last, 0.5);
+                        self.kin.set_guess(&x_ok);
+                        continue;
+                    }
+                    // no descent along the Newton direction: cut the increment
+                    break;
                 }
                 halvings = 0;
                 x_ok.copy_from_slice(self.kin.x());
@@ -397,7 +560,6 @@ impl Dynamics {
                 };
                 let mut dq: Vec<f64> = free.iter().map(|i| -g[*i]).collect();
                 factor.lu.solve_vec(&mut dq, &mut Mat::zeros(free.len(), 1));
-                let qn = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 let dn = dq.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 // (NaN included: a non-finite chord step is rejected too)
                 let contracts = dn <= CHORD_CONTRACTION * prev_dn;
@@ -413,6 +575,8 @@ impl Dynamics {
                     q[*i] += dq[k];
                 }
                 dq_last.copy_from_slice(&dq);
+                g_from = gn;
+                last_was_chord = !refreshed;
                 if dn <= opts.tol * (1.0 + qn) {
                     converged = true;
                     break;
