@@ -306,11 +306,7 @@ impl Dynamics {
         self.kin.first_order();
         if let Some(qd) = qd {
             if let Some(i) = qd.iter().position(|v| !v.is_finite()) {
-                return Err(DynamicsError::NonFinite {
-                    what: "q̇",
-                    index: i,
-                    t,
-                });
+                return Err(self.non_finite("q̇", qd, i, t));
             }
             self.kin.velocities(qd);
             self.kin.accelerations();
@@ -505,11 +501,7 @@ impl Dynamics {
             return self.accelerations_by_projection(t, q, qd, qdd);
         }
         if let Some(i) = qdd[..n].iter().position(|v| !v.is_finite()) {
-            return Err(DynamicsError::NonFinite {
-                what: "q̈",
-                index: i,
-                t,
-            });
+            return Err(self.non_finite("q̈", &qdd[..n], i, t));
         }
         Ok(())
     }
@@ -525,11 +517,7 @@ impl Dynamics {
         let kin_err = |e| DynamicsError::Kinematics { t, source: e };
         self.kin.solve_chord(q, t).map_err(kin_err)?;
         if let Some(i) = qd.iter().position(|v| !v.is_finite()) {
-            return Err(DynamicsError::NonFinite {
-                what: "q̇",
-                index: i,
-                t,
-            });
+            return Err(self.non_finite("q̇", qd, i, t));
         }
         self.kin.velocities_refined(qd).map_err(kin_err)?;
         self.kin.convective_terms();
@@ -583,11 +571,7 @@ impl Dynamics {
             MemStack::new(&mut self.llt_mem),
         );
         if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
-            return Err(DynamicsError::NonFinite {
-                what: "q̈",
-                index: i,
-                t,
-            });
+            return Err(self.non_finite("q̈", qdd, i, t));
         }
         Ok(())
     }
@@ -618,18 +602,42 @@ impl Dynamics {
         }
     }
 
+    /// The error for a mass matrix Mq that is not positive definite, naming
+    /// the DOFs without inertia ([`crate::massless_dofs`]).
     fn singular_mass(&self) -> DynamicsError {
-        // the DOF with the smallest diagonal mass relative to the largest
-        let n = self.mq.nrows();
-        let diag: Vec<f64> = (0..n).map(|i| self.mq[(i, i)]).collect();
-        let mx = diag.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let names: Vec<String> = diag
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| **v <= 1e-12 * mx)
-            .map(|(i, _)| self.mech.coordinate_name(self.mech.dofs[i]).to_string())
+        DynamicsError::SingularMass {
+            dofs: crate::massless_dofs(&self.mech, self.mq.as_ref()),
+        }
+    }
+
+    /// The error for the DOF-sized `values` of `what`, whose entry `index`
+    /// is the first that is not finite: names it and the next non-finite
+    /// ones (up to three in all; an overflow in one DOF often spreads to
+    /// others).
+    pub(crate) fn non_finite(
+        &self,
+        what: &'static str,
+        values: &[f64],
+        index: usize,
+        t: f64,
+    ) -> DynamicsError {
+        let bad: Vec<usize> = (index..values.len())
+            .filter(|k| !values[*k].is_finite())
             .collect();
-        DynamicsError::SingularMass { dofs: names }
+        let mut names: Vec<String> = bad
+            .iter()
+            .take(3)
+            .map(|k| self.mech.dof_label(*k))
+            .collect();
+        if bad.len() > 3 {
+            names.push(format!("{} more", bad.len() - 3));
+        }
+        DynamicsError::NonFinite {
+            what,
+            index,
+            name: names.join(", "),
+            t,
+        }
     }
 
     /// The residual g(q, q̇, q̈, t) = F,qᵀ(Mx ẍ − f) + E,qᵀσ of (E.1).

@@ -34,6 +34,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod culprit;
 mod eom;
 mod linearize;
 mod momentum;
@@ -52,9 +53,10 @@ pub(crate) fn fixture(name: &str) -> flexmb_model::Scene {
     flexmb_model::Scene::load(&p).unwrap()
 }
 
+pub use culprit::{massless_dofs, null_space_dofs, short_number};
 pub use eom::{Dynamics, Energies};
 pub use flexmb_ode::{Control, Stats};
-pub use linearize::Linearization;
+pub use linearize::{Linearization, LinearizedAt};
 pub use momentum::Momentum;
 pub use outputs::OutputTable;
 pub use simulate::{
@@ -74,26 +76,31 @@ pub enum DynamicsError {
         source: flexmb_kinematics::KinematicsError,
     },
     /// The mass matrix Mq is not positive definite.
-    #[error("the mass matrix is not positive definite: degrees of freedom without inertia: {dofs:?} (give them mass, or make them rigid or prescribed)")]
+    #[error("the mass matrix is not positive definite: degrees of freedom without inertia: {} (give them mass, or make them rigid or prescribed)", .dofs.join(", "))]
     SingularMass {
         /// The massless DOFs.
         dofs: Vec<String>,
     },
     /// A non-finite value.
-    #[error("non-finite {what} at index {index} (t = {t})")]
+    #[error("non-finite {what} of {name} at t = {t}")]
     NonFinite {
         /// Which quantity.
         what: &'static str,
         /// Index.
         index: usize,
+        /// What that entry is ([`flexmb_model::Mechanism::dof_label`]).
+        name: String,
         /// Time.
         t: f64,
     },
     /// The static tangent is singular (buckling or a mechanism).
-    #[error("singular static tangent at load factor {load_factor}: the structure buckles or a motion is unrestrained")]
+    #[error("singular static tangent at load factor {load_factor}: the structure buckles or a motion is unrestrained{}", culprit::listed("; the motion involves ", .unrestrained))]
     SingularTangent {
         /// Load factor reached.
         load_factor: f64,
+        /// The degrees of freedom of the estimated null vectors of the
+        /// tangent ([`null_space_dofs`]).
+        unrestrained: Vec<String>,
     },
     /// Statics did not converge.
     #[error("static equilibrium not found beyond load factor {load_factor}: {cause}")]

@@ -6,8 +6,9 @@
 
 use crate::{Dynamics, DynamicsError};
 use faer::Mat;
-use flexmb_model::{Coordinate, ERole, Load};
+use flexmb_model::{Coordinate, ERole, Load, Mechanism};
 use flexmb_rotation::EulerParameters;
+use std::sync::Arc;
 
 /// The linearized matrices of (E.5) (or their rest form (E.6)).
 #[derive(Clone, Debug)]
@@ -26,6 +27,76 @@ pub struct Linearization {
     /// position-dependent loads (consistent gravity on rotating elements,
     /// moments on Euler parameters), which (E.6) assumes absent.
     pub n: Mat<f64>,
+    /// Where it was made: the mechanism whose DOFs index the matrices and
+    /// the configuration, for the messages of analyses that fail on them.
+    pub at: LinearizedAt,
+}
+
+/// The mechanism and configuration of a [`Linearization`], to name the
+/// culprit when an analysis of its matrices fails.
+#[derive(Clone)]
+pub struct LinearizedAt {
+    /// The mechanism; its DOFs index the matrices.
+    pub mechanism: Arc<Mechanism>,
+    /// Time.
+    pub t: f64,
+    /// The degrees of freedom.
+    pub q: Vec<f64>,
+    /// The scale of the nodal loads ([`Dynamics::set_load_scale`]).
+    pub load_scale: f64,
+}
+
+impl std::fmt::Debug for LinearizedAt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LinearizedAt")
+            .field("mechanism", &self.mechanism.name)
+            .field("t", &self.t)
+            .field("q", &self.q)
+            .field("load_scale", &self.load_scale)
+            .finish()
+    }
+}
+
+/// At most this many DOFs are given when a configuration is described.
+const DESCRIBED_DOFS: usize = 3;
+
+impl LinearizedAt {
+    /// The configuration for messages: "at t = 0 s, the reference
+    /// configuration", or with the DOFs furthest from their reference values
+    /// ("at t = 0 s, load scale 0.5, where DOF q3 = S.x (node S) is 0.512
+    /// (reference 0.5), …").
+    pub fn describe(&self) -> String {
+        let mut s = format!("at t = {} s", self.t);
+        if self.load_scale != 1.0 {
+            s += &format!(", load scale {}", self.load_scale);
+        }
+        let q0 = self.mechanism.q0();
+        let mut moved: Vec<usize> = (0..self.q.len().min(q0.len()))
+            .filter(|k| self.q[*k] != q0[*k])
+            .collect();
+        if moved.is_empty() {
+            return s + ", the reference configuration";
+        }
+        let change = |k: &usize| (self.q[*k] - q0[*k]).abs();
+        moved.sort_by(|a, b| change(b).total_cmp(&change(a)));
+        let listed: Vec<String> = moved
+            .iter()
+            .take(DESCRIBED_DOFS)
+            .map(|k| {
+                format!(
+                    "{} is {} (reference {})",
+                    self.mechanism.dof_label(*k),
+                    crate::short_number(self.q[*k]),
+                    crate::short_number(q0[*k])
+                )
+            })
+            .collect();
+        let more = match moved.len().saturating_sub(DESCRIBED_DOFS) {
+            0 => String::new(),
+            m => format!(" and {m} more DOFs differ from the reference"),
+        };
+        format!("{s}, where {}{more}", listed.join(", "))
+    }
 }
 
 impl Linearization {
@@ -231,7 +302,16 @@ impl Dynamics {
         let g = self.kin.second_order_contraction(&wprime, &sigma);
         let k = self.structural_stiffness();
         let d = self.damping_matrix();
-        Ok(Linearization { m, d, c, k, g, n })
+        let at = self.linearized_at(t, q);
+        Ok(Linearization {
+            m,
+            d,
+            c,
+            k,
+            g,
+            n,
+            at,
+        })
     }
 
     /// The rest form (E.6) at an equilibrium (q̇ = 0, q̈ = 0): M, D, K, G, with
@@ -261,6 +341,17 @@ impl Dynamics {
             k,
             g,
             n,
+            at: self.linearized_at(t, q),
         })
+    }
+
+    /// The mechanism and configuration of a linearization at (t, q).
+    fn linearized_at(&self, t: f64, q: &[f64]) -> LinearizedAt {
+        LinearizedAt {
+            mechanism: self.mech.clone(),
+            t,
+            q: q.to_vec(),
+            load_scale: self.load_scale,
+        }
     }
 }

@@ -2,6 +2,7 @@
 //! the explicit integrators (the thesis counts evaluations of this right-hand
 //! side), and in residual form with tangents for generalized-α.
 
+use crate::culprit::{integration_error, StateLayout};
 use crate::{Dynamics, DynamicsError};
 use faer::Mat;
 use flexmb_model::{ChartSwitch, Coordinate, EulerChart, Mechanism};
@@ -209,14 +210,27 @@ pub fn integrate_explicit<S: OdeSystem + ?Sized>(
     opts: &SimulationOptions,
     t0: f64,
     y0: &[f64],
+    observer: impl FnMut(&mut S, f64, &[f64]) -> Control,
+) -> Result<(Stats, bool), DynamicsError> {
+    integrate_explicit_named(sys, opts, t0, y0, observer, |e| e.to_string())
+}
+
+/// [`integrate_explicit`] with the integrator's errors worded by `describe`
+/// (which may name the state component an error is about).
+fn integrate_explicit_named<S: OdeSystem + ?Sized>(
+    sys: &mut S,
+    opts: &SimulationOptions,
+    t0: f64,
+    y0: &[f64],
     mut observer: impl FnMut(&mut S, f64, &[f64]) -> Control,
+    describe: impl Fn(&flexmb_ode::OdeError) -> String,
 ) -> Result<(Stats, bool), DynamicsError> {
     let t_end = *opts
         .output_times
         .last()
         .ok_or_else(|| DynamicsError::Invalid("no output times".into()))?;
     let out = Output::Times(opts.output_times.clone());
-    let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(e.to_string());
+    let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(describe(&e));
     let dim = sys.dim();
     let cell = RefCell::new(sys);
     let mut shared = Shared { cell: &cell, dim };
@@ -640,7 +654,10 @@ impl Dynamics {
             traj.qd.push(qds);
             c
         };
-        let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(e.to_string());
+        let mech = self.mech.clone();
+        let to_err = |e: flexmb_ode::OdeError| {
+            DynamicsError::Integration(integration_error(&mech, StateLayout::SecondOrder, &e))
+        };
         let (stats, stopped, switch_at) = match opts.integrator {
             Integrator::Dopri5 | Integrator::Adams => {
                 let mut y0 = q0.to_vec();
@@ -650,9 +667,14 @@ impl Dynamics {
                     qdd: vec![0.0; n],
                     watch: Some(watch),
                 };
-                let run = integrate_explicit(&mut sys, opts, t0, &y0, |_, t: f64, y: &[f64]| {
-                    emit(t, &y[..n], &y[n..])
-                });
+                let run = integrate_explicit_named(
+                    &mut sys,
+                    opts,
+                    t0,
+                    &y0,
+                    |_, t: f64, y: &[f64]| emit(t, &y[..n], &y[n..]),
+                    |e| integration_error(&mech, StateLayout::FirstOrder, e),
+                );
                 let watch = sys.watch.expect("set above");
                 let (stats, stopped) = match run {
                     Ok(r) => r,

@@ -321,7 +321,11 @@ impl Dynamics {
         let tf = Mat::from_fn(free.len(), free.len(), |a, b| tan[(free[a], free[b])]);
         let mut lu = DenseLu::default();
         if !lu.factor(tf.as_ref()) {
-            return Err(DynamicsError::SingularTangent { load_factor });
+            // named once, when the solve gives up (see `unrestrained_at`)
+            return Err(DynamicsError::SingularTangent {
+                load_factor,
+                unrestrained: vec![],
+            });
         }
         let coupling = held
             .iter()
@@ -378,6 +382,31 @@ impl Dynamics {
         }
     }
 
+    /// The error for a static tangent found singular at q, naming the DOFs
+    /// of the motion it leaves unrestrained (estimated null vectors of the
+    /// tangent over the free DOFs, [`crate::null_space_dofs`]). Assembles
+    /// the tangent again: called once, when the solve gives up, not at every
+    /// retried increment.
+    fn unrestrained_at(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        free: &[usize],
+        load_factor: f64,
+    ) -> DynamicsError {
+        let unrestrained = match self.static_tangent(t, q) {
+            Ok((_, tan)) => {
+                let tf = Mat::from_fn(free.len(), free.len(), |a, b| tan[(free[a], free[b])]);
+                crate::null_space_dofs(&self.mech, tf.as_ref(), free)
+            }
+            Err(_) => vec![],
+        };
+        DynamicsError::SingularTangent {
+            load_factor,
+            unrestrained,
+        }
+    }
+
     /// Static equilibrium at time `t` (inputs at their values at t), starting
     /// from `q0`, with load increments and held degrees of freedom.
     ///
@@ -422,6 +451,9 @@ impl Dynamics {
         let mut last_good = q.clone();
         let mut last_err = None;
         let mut force_refresh = false;
+        // where the tangent was last found singular (q, load factor), to name
+        // the unrestrained motion if the solve gives up
+        let mut singular_at: Option<(Vec<f64>, f64)> = None;
         // the branch guard: the last update (to halve if its iterate flips an
         // element) and the configurations of the last unflipped iterate and of
         // the last converged increment (guesses for the kinematics after a
@@ -479,6 +511,9 @@ impl Dynamics {
                 let g = match evaluated {
                     Ok(g) => g,
                     Err(e) => {
+                        if matches!(e, DynamicsError::SingularTangent { .. }) {
+                            singular_at = Some((q.clone(), self.load_factor));
+                        }
                         last_err = Some(e);
                         break;
                     }
@@ -597,6 +632,17 @@ impl Dynamics {
                 let _ = self.kin.solve(&q, t);
                 dl *= 0.5;
                 if dl < opts.min_increment {
+                    if let (
+                        Some(DynamicsError::SingularTangent { load_factor, .. }),
+                        Some((qs, lf)),
+                    ) = (&last_err, &singular_at)
+                    {
+                        let load_factor = *load_factor;
+                        self.load_factor = *lf;
+                        last_err = Some(self.unrestrained_at(t, qs, &free, load_factor));
+                        self.kin.set_guess(&x_good);
+                        let _ = self.kin.solve(&q, t);
+                    }
                     self.load_factor = 1.0;
                     return Err(DynamicsError::StaticNotConverged {
                         load_factor: lambda,

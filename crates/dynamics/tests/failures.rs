@@ -54,3 +54,110 @@ fn a_mechanism_driven_out_of_reach_names_the_failing_equations() {
         );
     }
 }
+
+/// A free node S with a point mass: DOFs q0 = S.x, q1 = S.y.
+fn free_mass(mass: f64, force: f64) -> Arc<flexmb_model::Mechanism> {
+    let scene = Scene::from_ron_str(&format!(
+        r#"(
+        dimension: Planar,
+        nodes: [ (id: "S", at: [0.0, 0.0]) ],
+        elements: [ (id: "m", type: PointMass(node: "S", mass: {mass:e})) ],
+        loads: [ (node: "S", force: Some([0.0, {force:e}])) ],
+    )"#
+    ))
+    .unwrap();
+    let mech = Arc::new(scene.build(None).unwrap());
+    let names: Vec<&str> = mech.dofs.iter().map(|c| mech.coordinate_name(*c)).collect();
+    assert_eq!(names, ["S.x", "S.y"]);
+    mech
+}
+
+#[test]
+fn a_non_finite_acceleration_or_velocity_names_its_dof_and_node() {
+    // q̈ = f/m = 1e10 / 1e-300 overflows
+    let mut dy = Dynamics::new(free_mass(1e-300, 1e10));
+    let mut qdd = [0.0; 2];
+    let msg = dy
+        .accelerations(0.0, &[0.0, 0.0], &[0.0, 0.0], &mut qdd)
+        .expect_err("q̈ overflows")
+        .to_string();
+    // (the overflow spreads to S.x in the solve; both are named)
+    assert!(
+        msg.contains("non-finite q̈ of DOF q") && msg.contains("DOF q1 = S.y (node S)"),
+        "{msg}"
+    );
+    let mut dy = Dynamics::new(free_mass(1.0, 1.0));
+    let msg = dy
+        .accelerations(0.0, &[0.0, 0.0], &[0.0, f64::NAN], &mut qdd)
+        .expect_err("q̇ is NaN")
+        .to_string();
+    assert!(
+        msg.contains("non-finite q̇ of DOF q1 = S.y (node S)"),
+        "{msg}"
+    );
+    let msg = dy
+        .accelerations(0.0, &[f64::INFINITY, 0.0], &[0.0, 0.0], &mut qdd)
+        .expect_err("q is infinite")
+        .to_string();
+    assert!(msg.contains("DOF q0 = S.x (node S)"), "{msg}");
+}
+
+#[test]
+fn a_non_finite_initial_velocity_names_its_dof_and_node_for_every_integrator() {
+    let mech = free_mass(1.0, 1.0);
+    for integrator in [
+        Integrator::Dopri5,
+        Integrator::Adams,
+        Integrator::GeneralizedAlpha,
+    ] {
+        let mut dy = Dynamics::new(mech.clone());
+        let opts = SimulationOptions::new(integrator, 0.0, 0.1, 3);
+        let msg = dy
+            .simulate(0.0, &[0.0, 0.0], &[0.0, f64::NAN], &opts, |_, _, _| {
+                Control::Continue
+            })
+            .expect_err("q̇0 is NaN")
+            .to_string();
+        assert!(
+            msg.contains("non-finite component")
+                && msg.contains("the rate of DOF q1 = S.y (node S)"),
+            "{integrator:?}: {msg}"
+        );
+    }
+}
+
+#[test]
+fn a_singular_static_tangent_names_the_unrestrained_coordinates() {
+    // a clamped beam A–B and a truss B–S along x with a mass at S: nothing
+    // resists S moving in y (the truss turning about B)
+    let scene = Scene::from_ron_str(
+        r#"(
+        dimension: Planar,
+        gravity: Some([0.0, -9.81]),
+        materials: { "al": (e: 7.0e10, rho: 2700.0) },
+        sections: { "bar": Rectangle(by: 0.01, bz: 0.02) },
+        nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [0.5, 0.0]), (id: "S", at: [1.0, 0.0]) ],
+        elements: [
+            (id: "ab", type: Beam((nodes: ("A", "B"), material: "al", section: "bar"))),
+            (id: "bs", type: Truss(nodes: ("B", "S"), ea: 1.0e6)),
+            (id: "m", type: PointMass(node: "S", mass: 1.0)),
+        ],
+        fixed: [ Node("A") ],
+    )"#,
+    )
+    .unwrap();
+    let mech = Arc::new(scene.build(None).unwrap());
+    let mut dy = Dynamics::new(mech.clone());
+    let msg = dy
+        .static_equilibrium(0.0, &mech.q0(), &Default::default())
+        .expect_err("S.y is unrestrained")
+        .to_string();
+    assert!(
+        msg.contains("singular static tangent") && msg.contains("the motion involves DOF q"),
+        "{msg}"
+    );
+    // S.y, and only the coordinates of that motion
+    let named = msg.split("the motion involves ").nth(1).unwrap_or("");
+    assert!(named.contains("S.y (node S)"), "{msg}");
+    assert!(!named.contains("ab.") && !named.contains("bs."), "{msg}");
+}

@@ -44,9 +44,11 @@
 
 mod jacobian_lu;
 mod lu;
+mod null_space;
 
 pub use jacobian_lu::{JacobianLu, DENSE_UP_TO};
 pub use lu::DenseLu;
+pub use null_space::null_vectors;
 
 use faer::Mat;
 use flexmb_model::{Coordinate, ERole, Mechanism, XRole};
@@ -135,12 +137,14 @@ pub enum KinematicsError {
         value: f64,
     },
     /// Non-finite input.
-    #[error("non-finite value in {what} at index {index}")]
+    #[error("non-finite value in {what}: {name}")]
     NonFinite {
         /// Which input.
         what: &'static str,
         /// Index.
         index: usize,
+        /// What that entry is, e.g. `DOF q3 = S.x (node S)`.
+        name: String,
     },
 }
 
@@ -654,6 +658,7 @@ impl Kinematics {
             return Err(KinematicsError::NonFinite {
                 what: "q",
                 index: i,
+                name: self.mech.dof_label(i),
             });
         }
         let n_u = self.n_u;

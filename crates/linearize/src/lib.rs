@@ -43,6 +43,20 @@ pub use sweep::{sweep, SweepOptions, SweepParameter, SweepPoint};
 
 use faer::Mat;
 
+/// `prefix` and the non-empty names joined by commas, or nothing.
+fn listed(prefix: &str, names: &[String]) -> String {
+    let names: Vec<&str> = names
+        .iter()
+        .map(|s| s.as_str())
+        .filter(|s| !s.is_empty())
+        .collect();
+    if names.is_empty() {
+        String::new()
+    } else {
+        format!("{prefix}{}", names.join(", "))
+    }
+}
+
 /// Mode shapes in nodal coordinates: F,q V (n_x × k), at the configuration of
 /// the last evaluation of `dy` (F,q is computed there if that evaluation did
 /// not need it, e.g. after `Dynamics::accelerations`).
@@ -62,19 +76,44 @@ pub enum LinearizeError {
     #[error("non-finite entries in the {0}")]
     NonFinite(&'static str),
     /// The mass matrix is not positive definite.
-    #[error("the mass matrix is not positive definite: some degree of freedom has no inertia")]
-    MassNotPositive,
+    #[error(
+        "the mass matrix is not positive definite: some degree of freedom has no inertia{}",
+        listed(": ", dofs)
+    )]
+    MassNotPositive {
+        /// The DOFs without inertia (empty when the matrices come without a
+        /// mechanism), see [`flexmb_dynamics::massless_dofs`].
+        dofs: Vec<String>,
+    },
     /// The structural stiffness is not positive definite (buckling needs it).
-    #[error("the structural stiffness is not positive definite: the structure has a mechanism (unrestrained motion)")]
-    StiffnessNotPositive,
+    #[error("the structural stiffness is not positive definite: the structure has a mechanism (unrestrained motion){}", listed("; it involves ", dofs))]
+    StiffnessNotPositive {
+        /// The DOFs of the unrestrained motion (empty without a mechanism),
+        /// see [`flexmb_dynamics::null_space_dofs`].
+        dofs: Vec<String>,
+    },
     /// An eigen solver did not converge.
-    #[error("the eigenvalue solver did not converge")]
-    NoConvergence,
-    /// The equilibrium of a sweep configuration failed.
-    #[error("sweep configuration s = {s}: {message}")]
-    Equilibrium {
+    #[error(
+        "the eigenvalue solver did not converge{}",
+        listed(" ", std::slice::from_ref(at))
+    )]
+    NoConvergence {
+        /// The configuration ([`flexmb_dynamics::LinearizedAt::describe`]),
+        /// empty when the matrices come without one.
+        at: String,
+    },
+    /// A configuration of a sweep failed: its equilibrium, its linearization
+    /// or its eigen analysis.
+    #[error("sweep configuration {index} of {count} ({at}): {message}")]
+    SweepConfiguration {
+        /// Its number, from 1.
+        index: usize,
+        /// The number of configurations.
+        count: usize,
         /// Sweep parameter.
         s: f64,
+        /// The configuration: the load scale, or the held DOFs and values.
+        at: String,
         /// Cause.
         message: String,
     },

@@ -101,7 +101,7 @@ pub fn generalized_symmetric(
     let (ks, ms) = (sym(k), sym(m));
     let mllt = ms
         .llt(Side::Lower)
-        .map_err(|_| LinearizeError::MassNotPositive)?;
+        .map_err(|_| LinearizeError::MassNotPositive { dofs: vec![] })?;
     let count = count.min(n);
     let vectors: Mat<f64> = match ks.llt(Side::Lower) {
         Ok(kllt) => {
@@ -109,7 +109,7 @@ pub fn generalized_symmetric(
             let l = kllt.L().to_owned();
             let evd = congruence(&l, &ms)
                 .self_adjoint_eigen(Side::Lower)
-                .map_err(|_| LinearizeError::NoConvergence)?;
+                .map_err(|_| LinearizeError::NoConvergence { at: String::new() })?;
             let u = evd.U();
             back_substitute(&l, Mat::from_fn(n, count, |i, j| u[(i, n - 1 - j)]))
         }
@@ -118,7 +118,7 @@ pub fn generalized_symmetric(
             let l = mllt.L().to_owned();
             let evd = congruence(&l, &ks)
                 .self_adjoint_eigen(Side::Lower)
-                .map_err(|_| LinearizeError::NoConvergence)?;
+                .map_err(|_| LinearizeError::NoConvergence { at: String::new() })?;
             let u = evd.U();
             back_substitute(&l, Mat::from_fn(n, count, |i, j| u[(i, j)]))
         }
@@ -144,7 +144,32 @@ pub fn generalized_symmetric(
 /// symmetric part of the stiffness (at rest with conservative loads the
 /// tangent is symmetric; its asymmetry is reported by [`asymmetry`]).
 pub fn undamped_modes(lin: &Linearization, count: usize) -> Result<Modes, LinearizeError> {
-    generalized_symmetric(&lin.stiffness_total(), &lin.m, count)
+    generalized_symmetric(&lin.stiffness_total(), &lin.m, count).map_err(|e| named(lin, e))
+}
+
+/// An analysis error of `lin`'s matrices with its culprit named from the
+/// mechanism and configuration of `lin`: the DOFs without inertia, the DOFs
+/// of an unrestrained motion, the configuration where the eigenvalue solver
+/// failed.
+fn named(lin: &Linearization, e: LinearizeError) -> LinearizeError {
+    let mech = &lin.at.mechanism;
+    match e {
+        LinearizeError::MassNotPositive { dofs } if dofs.is_empty() => {
+            LinearizeError::MassNotPositive {
+                dofs: flexmb_dynamics::massless_dofs(mech, sym(&lin.m).as_ref()),
+            }
+        }
+        LinearizeError::StiffnessNotPositive { dofs } if dofs.is_empty() => {
+            let all: Vec<usize> = (0..lin.k.nrows()).collect();
+            LinearizeError::StiffnessNotPositive {
+                dofs: flexmb_dynamics::null_space_dofs(mech, sym(&lin.k).as_ref(), &all),
+            }
+        }
+        LinearizeError::NoConvergence { at } if at.is_empty() => LinearizeError::NoConvergence {
+            at: lin.at.describe(),
+        },
+        e => e,
+    }
 }
 
 /// ‖A − Aᵀ‖ / ‖A‖ (max norms).
@@ -182,13 +207,18 @@ pub struct DampedMode {
 /// oscillating pair (Im λ > 0) or real eigenvalue, sorted by |λ|. For
 /// gyroscopic, damped and controlled states (thesis Table 7.2).
 pub fn damped_modes(lin: &Linearization) -> Result<Vec<DampedMode>, LinearizeError> {
+    state_space_modes(lin).map_err(|e| named(lin, e))
+}
+
+/// [`damped_modes`] without naming the culprit of a failure.
+fn state_space_modes(lin: &Linearization) -> Result<Vec<DampedMode>, LinearizeError> {
     let n = lin.m.nrows();
     if n == 0 {
         return Ok(vec![]);
     }
     let llt = sym(&lin.m)
         .llt(Side::Lower)
-        .map_err(|_| LinearizeError::MassNotPositive)?;
+        .map_err(|_| LinearizeError::MassNotPositive { dofs: vec![] })?;
     let mut mk = lin.stiffness_total();
     let mut mc = lin.damping_total();
     llt.solve_in_place(mk.as_mut());
@@ -206,7 +236,9 @@ pub fn damped_modes(lin: &Linearization) -> Result<Vec<DampedMode>, LinearizeErr
             -mc[(i - n, j - n)]
         }
     });
-    let ev = a.eigenvalues().map_err(|_| LinearizeError::NoConvergence)?;
+    let ev = a
+        .eigenvalues()
+        .map_err(|_| LinearizeError::NoConvergence { at: String::new() })?;
     let mut out: Vec<DampedMode> = ev
         .iter()
         .filter(|z| z.im >= -1e-12 * z.re.abs().max(z.im.abs()).max(1e-300))
@@ -228,10 +260,15 @@ pub fn damped_modes(lin: &Linearization) -> Result<Vec<DampedMode>, LinearizeErr
 /// geometric stiffness of the current loads): the loads times μ make K + μG
 /// singular. Returns the `count` smallest positive μ. K must be positive definite.
 pub fn buckling_factors(lin: &Linearization, count: usize) -> Result<Vec<f64>, LinearizeError> {
+    buckling_eigenvalues(lin, count).map_err(|e| named(lin, e))
+}
+
+/// [`buckling_factors`] without naming the culprit of a failure.
+fn buckling_eigenvalues(lin: &Linearization, count: usize) -> Result<Vec<f64>, LinearizeError> {
     let n = lin.k.nrows();
     let kllt = sym(&lin.k)
         .llt(Side::Lower)
-        .map_err(|_| LinearizeError::StiffnessNotPositive)?;
+        .map_err(|_| LinearizeError::StiffnessNotPositive { dofs: vec![] })?;
     let l = kllt.L().to_owned();
     let mut g = sym(&lin.g);
     g += &sym(&lin.n);
@@ -242,7 +279,7 @@ pub fn buckling_factors(lin: &Linearization, count: usize) -> Result<Vec<f64>, L
     }
     let vals = congruence(&l, &g)
         .self_adjoint_eigenvalues(Side::Lower)
-        .map_err(|_| LinearizeError::NoConvergence)?;
+        .map_err(|_| LinearizeError::NoConvergence { at: String::new() })?;
     // eigenvalues ν of Lk⁻¹(−G)Lk⁻ᵀ: μ = 1/ν for ν > 0
     let mut mu: Vec<f64> = vals
         .iter()

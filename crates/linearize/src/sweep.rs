@@ -5,7 +5,7 @@
 
 use crate::{undamped_modes, LinearizeError, Modes};
 use faer::Mat;
-use flexmb_dynamics::{Dynamics, StaticOptions};
+use flexmb_dynamics::{short_number, Dynamics, StaticOptions};
 use flexmb_model::Mechanism;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -56,6 +56,46 @@ pub struct SweepPoint {
     pub mass: Option<Mat<f64>>,
 }
 
+/// Sweep configuration `i` for messages: "load scale 0.5", or "s = 0.01:
+/// DOF q3 = S.x (node S) held at 0.51" (every held DOF, at most four named).
+fn describe_point(mech: &Mechanism, param: &SweepParameter, s: f64) -> String {
+    let held = |dofs: &[usize], values: &[f64]| {
+        let mut v: Vec<String> = dofs
+            .iter()
+            .zip(values)
+            .take(4)
+            .map(|(k, v)| format!("{} held at {}", mech.dof_label(*k), short_number(*v)))
+            .collect();
+        if dofs.len() > 4 {
+            v.push(format!("and {} more held DOFs", dofs.len() - 4));
+        }
+        v.join(", ")
+    };
+    match param {
+        SweepParameter::LoadScale => format!("load scale {s}"),
+        SweepParameter::Dof(k) => held(&[*k], &[s]),
+        SweepParameter::Path { dofs, path } => format!("s = {s}: {}", held(dofs, &path(s))),
+    }
+}
+
+/// The error of sweep configuration `i` with the cause `message`.
+fn failed_at(
+    mech: &Mechanism,
+    param: &SweepParameter,
+    opts: &SweepOptions,
+    i: usize,
+    message: String,
+) -> LinearizeError {
+    let s = opts.values[i];
+    LinearizeError::SweepConfiguration {
+        index: i + 1,
+        count: opts.values.len(),
+        s,
+        at: describe_point(mech, param, s),
+        message,
+    }
+}
+
 /// Runs a sweep. `progress(done, total)` is called as configurations finish.
 pub fn sweep(
     mech: &Arc<Mechanism>,
@@ -86,12 +126,9 @@ pub fn sweep(
                 so.held = dofs.iter().copied().zip(v).collect();
             }
         }
-        let sol =
-            dy.static_equilibrium(opts.t, &q, &so)
-                .map_err(|e| LinearizeError::Equilibrium {
-                    s,
-                    message: e.to_string(),
-                })?;
+        let sol = dy
+            .static_equilibrium(opts.t, &q, &so)
+            .map_err(|e| failed_at(mech, param, opts, i, e.to_string()))?;
         q = sol.q;
         qs.push(q.clone());
         xs.push(sol.x);
@@ -123,13 +160,12 @@ pub fn sweep(
                     let i = c * chunk + j;
                     dy.set_load_scale(scale[i]);
                     dy.kinematics_mut().set_guess(&xs[i]);
-                    let lin = dy.linearize_at_rest(opts.t, q).map_err(|e| {
-                        LinearizeError::Equilibrium {
-                            s: opts.values[i],
-                            message: e.to_string(),
-                        }
-                    })?;
-                    let modes = undamped_modes(&lin, opts.modes)?;
+                    let fail = |m: String| failed_at(mech, param, opts, i, m);
+                    let lin = dy
+                        .linearize_at_rest(opts.t, q)
+                        .map_err(|e| fail(e.to_string()))?;
+                    let modes =
+                        undamped_modes(&lin, opts.modes).map_err(|e| fail(e.to_string()))?;
                     let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     progress(d, total);
                     Ok((modes, lin.m))

@@ -114,6 +114,56 @@ fn material(id: &str, m: &MaterialSpec) -> Result<Material, ModelError> {
     Ok(mat)
 }
 
+/// The first cycle of `position_of` references (nodes each sharing the
+/// position of the next, back to the first), as an error naming it:
+/// "position_of cycle: A → B → A". O(nodes): each node is walked once.
+fn position_of_cycle(nodes: &[NodeSpec]) -> Result<(), ModelError> {
+    let target: HashMap<&str, &str> = nodes
+        .iter()
+        .filter_map(|n| n.position_of.as_deref().map(|o| (n.id.as_str(), o)))
+        .collect();
+    // 1: on the walk in progress, 2: walked before (on no cycle)
+    let mut state: HashMap<&str, u8> = HashMap::new();
+    for start in nodes {
+        let mut walk: Vec<&str> = vec![];
+        let mut cur = start.id.as_str();
+        let back_to = loop {
+            match state.get(cur) {
+                Some(1) => break Some(cur),
+                Some(_) => break None,
+                None => {}
+            }
+            state.insert(cur, 1);
+            walk.push(cur);
+            match target.get(cur) {
+                Some(next) => cur = next,
+                None => break None,
+            }
+        };
+        if let Some(k) = back_to.and_then(|c| walk.iter().position(|n| *n == c)) {
+            // start at the node declared first
+            let mut cycle = walk[k..].to_vec();
+            let declared = |id: &str| nodes.iter().position(|n| n.id == id);
+            let first = (0..cycle.len())
+                .min_by_key(|i| declared(cycle[*i]))
+                .unwrap_or(0);
+            cycle.rotate_left(first);
+            cycle.push(cycle[0]);
+            return Err(ModelError::invalid(
+                format!("node '{}' position_of", cycle[0]),
+                format!(
+                    "position_of cycle: {}; a node can only share the position of a node that has one of its own (`at`)",
+                    cycle.join(" → ")
+                ),
+            ));
+        }
+        for n in walk {
+            state.insert(n, 2);
+        }
+    }
+    Ok(())
+}
+
 /// Assembles a scene. `base_dir` resolves relative superelement file paths.
 pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelError> {
     let dim = scene.dimension;
@@ -125,12 +175,19 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
     let mut node_at: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut node_order: Vec<String> = vec![];
     let mut shares: HashMap<String, String> = HashMap::new();
+    position_of_cycle(&scene.nodes)?;
     for n in &scene.nodes {
         if n.id.is_empty() {
             return Err(ModelError::invalid("node", "an empty id"));
         }
         let mut n = n.clone();
         if let Some(other) = &n.position_of {
+            if !node_at.contains_key(other) && scene.nodes.iter().any(|m| m.id == *other) {
+                return Err(ModelError::invalid(
+                    format!("node '{}' position_of", n.id),
+                    format!("'{other}' is declared after '{}': a node shares the position of an earlier node; declare '{other}' first", n.id),
+                ));
+            }
             let at = node_at
                 .get(other)
                 .cloned()
@@ -700,6 +757,7 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
         outputs: scene.outputs.clone(),
         initial_xd: vec![0.0; n_x],
     };
+    mech.check_outputs()?;
     check_reference_configuration(&mech, &part_axes)?;
     crate::roles::assign(scene, &mut mech)?;
     crate::loads::assign(scene, &mut mech)?;

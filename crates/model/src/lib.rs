@@ -32,6 +32,8 @@ mod chart;
 mod error;
 mod loads;
 mod mechanism;
+mod naming;
+mod outputs;
 mod roles;
 mod scene;
 mod time_function;

@@ -452,3 +452,83 @@ fn a_chain_too_long_is_refused_before_anything_is_allocated() {
     // two bending deformations per beam of the chain, two of bc
     assert_eq!(m.n_dof(), 2 * 2000 + 2);
 }
+
+#[test]
+fn a_position_of_cycle_is_reported_as_a_cycle_naming_its_nodes() {
+    // B shares the position of C and C that of B: neither has a position
+    let e = err(&variant(
+        r#"(id: "B", at: [1.0, 0.0]), (id: "C", at: [1.0, 1.0])"#,
+        r#"(id: "B", position_of: Some("C")), (id: "C", position_of: Some("B"))"#,
+    ));
+    assert!(e.contains("position_of cycle: B → C → B"), "{e}");
+    // a longer cycle, entered from a node that is not on it
+    let e = err(&variant(
+        r#"(id: "B", at: [1.0, 0.0]), (id: "C", at: [1.0, 1.0])"#,
+        r#"(id: "B", position_of: Some("D")), (id: "C", position_of: Some("E")),
+           (id: "D", position_of: Some("E")), (id: "E", position_of: Some("C"))"#,
+    ));
+    assert!(e.contains("position_of cycle: C → E → C"), "{e}");
+    // a node that names itself
+    let e = err(&variant(
+        r#"(id: "C", at: [1.0, 1.0])"#,
+        r#"(id: "C", position_of: Some("C"))"#,
+    ));
+    assert!(e.contains("position_of cycle: C → C"), "{e}");
+    // no cycle, but a node declared later: said so, not "unknown node"
+    let e = err(&variant(
+        r#"(id: "B", at: [1.0, 0.0]), (id: "C", at: [1.0, 1.0])"#,
+        r#"(id: "B", position_of: Some("C")), (id: "C", at: [1.0, 1.0])"#,
+    ));
+    assert!(
+        e.contains("'C' is declared after 'B'") && !e.contains("unknown node"),
+        "{e}"
+    );
+}
+
+#[test]
+fn outputs_that_name_what_the_mechanism_lacks_are_refused_when_building() {
+    let with = |outputs: &str| variant("fixed:", &format!("outputs: [ {outputs} ],\n    fixed:"));
+    // the valid ones build
+    Scene::from_ron_str(&with(
+        r#"Position("C"), Rotation("C"), Deformation("bc", "*"), Stress("ab", "elongation"), Energies, Dofs"#,
+    ))
+    .unwrap()
+    .build(None)
+    .unwrap();
+    let e = err(&with(r#"Position("CC")"#));
+    assert!(
+        e.contains(r#"output Position("CC")"#)
+            && e.contains("unknown node 'CC'")
+            && e.contains("did you mean 'C'"),
+        "{e}"
+    );
+    let e = err(&with(r#"Deformation("bd", "*")"#));
+    assert!(
+        e.contains(r#"output Deformation("bd", "*")"#) && e.contains("unknown element 'bd'"),
+        "{e}"
+    );
+    let e = err(&with(r#"Stress("bc", "torsion")"#));
+    assert!(
+        e.contains(r#"output Stress("bc", "torsion")"#) && e.contains("no deformation 'torsion'"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_rotation_output_of_a_node_without_rotation_is_refused() {
+    // trusses use only the positions of their nodes
+    let text = r#"(
+        dimension: Planar,
+        materials: { "al": (e: 7.0e10, rho: 2700.0) },
+        sections: { "bar": Rectangle(by: 0.01, bz: 0.02) },
+        nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [1.0, 0.0]) ],
+        elements: [ (id: "ab", type: Truss(nodes: ("A", "B"), ea: 1.0e6, mass_per_length: 1.0)) ],
+        fixed: [ Node("A"), Coord("B", Y) ],
+        outputs: [ Rotation("B") ],
+    )"#;
+    let e = err(text);
+    assert!(
+        e.contains(r#"output Rotation("B")"#) && e.contains("node 'B' has no rotation"),
+        "{e}"
+    );
+}
