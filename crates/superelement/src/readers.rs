@@ -616,6 +616,38 @@ impl InpMesh {
     }
 }
 
+/// The most labels one `GENERATE` line may produce (more is taken for a
+/// typo, not expanded until memory runs out).
+const MAX_GENERATED: u64 = 10_000_000;
+
+/// The labels of a `GENERATE` data line `first, last[, step]` of *NSET or
+/// *ELSET.
+fn generated(nums: &[u64], file: &str, line: usize) -> Result<Vec<u64>, Error> {
+    let (a, b, step) = match *nums {
+        [a] => (a, a, 1),
+        [a, b] => (a, b, 1),
+        [a, b, st] => (a, b, st),
+        _ => {
+            return Err(Error::parse(
+                file,
+                line,
+                format!("GENERATE expects 'first, last[, step]', got {nums:?}"),
+            ))
+        }
+    };
+    if b < a || step == 0 || (b - a) / step >= MAX_GENERATED {
+        return Err(Error::parse(
+            file,
+            line,
+            format!(
+                "GENERATE range {a}, {b}, {step}: needs first ≤ last, a step ≥ 1 and at most \
+                 {MAX_GENERATED} labels"
+            ),
+        ));
+    }
+    Ok((a..=b).step_by(step as usize).collect())
+}
+
 /// How deep `*INCLUDE`s may nest (deeper is taken for a cycle).
 const MAX_INCLUDE_DEPTH: usize = 16;
 
@@ -812,7 +844,7 @@ impl InpParser {
                 Block::Elset(name, generate) => {
                     let set = name.clone();
                     let generate = *generate;
-                    self.elset_line(&set, generate, &f);
+                    self.elset_line(&set, generate, &f, file, ln + 1)?;
                 }
                 Block::Density(material) => {
                     // the first value of each data line (the others are temperatures)
@@ -831,42 +863,54 @@ impl InpParser {
                             })
                         })
                         .collect::<Result<_, _>>()?;
-                    let set = self.mesh.nsets.entry(name.clone()).or_default();
-                    if *generate {
-                        let (a, b, st) = (
-                            nums[0],
-                            *nums.get(1).unwrap_or(&nums[0]),
-                            *nums.get(2).unwrap_or(&1),
-                        );
-                        let mut k = a;
-                        while k <= b {
-                            set.push(k);
-                            k += st.max(1);
-                        }
+                    let labels = if *generate {
+                        generated(&nums, file, ln + 1)?
                     } else {
-                        set.extend(nums);
-                    }
+                        nums
+                    };
+                    self.mesh
+                        .nsets
+                        .entry(name.clone())
+                        .or_default()
+                        .extend(labels);
                 }
             }
         }
         Ok(())
     }
 
-    /// One data line of *ELSET: element labels (a range with `GENERATE`) or
-    /// names of other element sets. What cannot be read is left out (the
-    /// sets only serve the densities of the rigid-body check, which is then
-    /// skipped for the elements concerned).
-    fn elset_line(&mut self, set: &str, generate: bool, f: &[&str]) {
+    /// One data line of *ELSET: element labels (`first, last, step` with
+    /// `GENERATE`) or names of other element sets.
+    fn elset_line(
+        &mut self,
+        set: &str,
+        generate: bool,
+        f: &[&str],
+        file: &str,
+        line: usize,
+    ) -> Result<(), Error> {
         let nums: Vec<Option<u64>> = f.iter().map(|s| s.parse().ok()).collect();
-        let entry = self.mesh.elsets.entry(set.to_string()).or_default();
         if generate {
-            if let [Some(a), rest @ ..] = nums.as_slice() {
-                let b = rest.first().copied().flatten().unwrap_or(*a);
-                let st = rest.get(1).copied().flatten().unwrap_or(1).max(1);
-                entry.extend((*a..=b).step_by(st as usize));
+            let n: Vec<u64> = nums.iter().map_while(|x| *x).collect();
+            if n.len() != nums.len() {
+                return Err(Error::parse(
+                    file,
+                    line,
+                    format!(
+                        "*ELSET, GENERATE expects 'first, last[, step]', got '{}'",
+                        f.join(", ")
+                    ),
+                ));
             }
-            return;
+            let labels = generated(&n, file, line)?;
+            self.mesh
+                .elsets
+                .entry(set.to_string())
+                .or_default()
+                .extend(labels);
+            return Ok(());
         }
+        let entry = self.mesh.elsets.entry(set.to_string()).or_default();
         for (s, n) in f.iter().zip(nums) {
             match n {
                 Some(n) => entry.push(n),
@@ -875,6 +919,7 @@ impl InpParser {
                     .push((set.to_string(), s.to_ascii_uppercase())),
             }
         }
+        Ok(())
     }
 
     fn include(

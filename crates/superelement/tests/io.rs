@@ -697,3 +697,30 @@ fn mass_from_another_grid_is_refused_by_the_sparsity_check() {
         &["M couples equation", "between which K has no entry"],
     );
 }
+
+/// GENERATE lines of *NSET and *ELSET: a range, and errors (not a panic, not
+/// an allocation until memory runs out) for an empty line, a reversed range,
+/// a zero step and a range of 10^12 labels.
+#[test]
+fn generate_ranges_are_checked() {
+    let base = "*NODE\n1, 0, 0, 0\n";
+    let mesh = parse_inp(
+        &format!("{base}*NSET, NSET=A, GENERATE\n1, 9, 4\n"),
+        "g.inp",
+    )
+    .unwrap();
+    assert_eq!(mesh.nsets["A"], vec![1, 5, 9]);
+    for kw in ["*NSET, NSET=A", "*ELSET, ELSET=A"] {
+        for (line, words) in [
+            (",", "first, last"),
+            ("9, 1", "first ≤ last"),
+            ("1, 9, 0", "step ≥ 1"),
+            ("1, 1000000000000", "at most 10000000 labels"),
+        ] {
+            expect_err(
+                parse_inp(&format!("{base}{kw}, GENERATE\n{line}\n"), "g.inp"),
+                &["g.inp:4", words],
+            );
+        }
+    }
+}
