@@ -610,8 +610,16 @@ fn build_superelement(spec_path: &Path) -> Result<(), Failure> {
     let spec =
         flexmb_superelement::Spec::read(spec_path).map_err(|e| Failure::Input(e.to_string()))?;
     let base = spec_path.parent().unwrap_or(Path::new("."));
-    let out = flexmb_superelement::build_from_spec(&spec, base)
-        .map_err(|e| Failure::Compute(e.to_string()))?;
+    // errors in the input files (unreadable, truncated, mismatched K and M,
+    // a model that cannot be reduced) are input errors, exit code 2; a
+    // failed solver or write is exit code 1
+    let out = flexmb_superelement::build_from_spec(&spec, base).map_err(|e| {
+        if e.is_input() {
+            Failure::Input(e.to_string())
+        } else {
+            Failure::Compute(e.to_string())
+        }
+    })?;
     println!("{:#?}", out.result.report);
     for f in &out.written {
         println!("wrote {}", f.display());

@@ -682,24 +682,13 @@ impl<'a> Ctx<'a> {
         Problem::new(e, self.model, &|j| self.describe(labels[j]))
     }
 
-    /// Structural checks before any factorization: connectivity to the interfaces,
-    /// negative diagonal, free-free rigid-body energy, plausible density.
+    /// Structural checks before any factorization (after the checks of K and M
+    /// against each other and the mesh, [`crate::consistency`]): connectivity
+    /// to the interfaces and a plausible density. Returns the FE mass.
     fn checks(&self, s: &BuildSettings) -> Result<f64, Error> {
         let model = self.model;
         let k = model.k();
         let n_eq = model.n_eq();
-        // negative diagonal
-        for j in 0..n_eq {
-            for (&i, &v) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
-                if i == j && v < 0.0 {
-                    return Err(Error::NotPositiveSemiDefinite(format!(
-                        "K[{0},{0}] = {v:e} < 0 at {1}",
-                        j,
-                        model.describe_eq(j)
-                    )));
-                }
-            }
-        }
         // connectivity (union–find over nodes, link masters and the two boundary nodes)
         let n_nodes = model.n_nodes();
         let nl = self.links.len();
@@ -752,42 +741,6 @@ impl<'a> Ctx<'a> {
                 )));
             }
         }
-        // free-free: rigid motions must store no energy
-        let c = centroid(model.coords());
-        let size = bbox_diag(model);
-        for (name, t, th) in rigid_motions(size) {
-            let u = model.rigid_field(t, th, c);
-            let mut ku = Mat::<f64>::zeros(n_eq, 1);
-            crate::model::sym_mul_add(
-                k,
-                faer::MatRef::from_column_major_slice(&u, n_eq, 1),
-                ku.as_mut(),
-            );
-            let e: f64 = (0..n_eq).map(|i| u[i] * ku[(i, 0)]).sum();
-            let mut scale = 0.0;
-            for j in 0..n_eq {
-                for (&i, &v) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
-                    if i == j {
-                        scale += v * u[j] * u[j];
-                    }
-                }
-            }
-            if e.abs() > 1e-8 * scale {
-                let (imax, _) = (0..n_eq).fold((0, 0.0f64), |acc, i| {
-                    if ku[(i, 0)].abs() > acc.1 {
-                        (i, ku[(i, 0)].abs())
-                    } else {
-                        acc
-                    }
-                });
-                return Err(Error::NotPositiveSemiDefinite(format!(
-                    "K is not free-free: the rigid {name} stores energy (ratio {:.1e}); remove boundary conditions and \
-                     springs to ground from the export. The largest residual force is at {}",
-                    e / scale,
-                    model.describe_eq(imax)
-                )));
-            }
-        }
         Ok(mass)
     }
 }
@@ -809,7 +762,9 @@ fn rigid_rows(r0: &[[f64; 3]; 3], d: [f64; 3]) -> [[f64; 6]; 3] {
     t
 }
 
-fn rigid_motions(size: f64) -> [(&'static str, [f64; 3], [f64; 3]); 6] {
+/// The six rigid motions (name, translation, rotation) with rotations of
+/// 1/size rad, so that the displacements of a part of that size are O(1).
+pub(crate) fn rigid_motions(size: f64) -> [(&'static str, [f64; 3], [f64; 3]); 6] {
     let r = 1.0 / size;
     [
         ("translation x", [1.0, 0.0, 0.0], [0.0; 3]),
@@ -1013,6 +968,7 @@ fn to_na(m: &Mat<f64>) -> DMatrix<f64> {
 pub fn build(model: &FeModel, s: &BuildSettings) -> Result<BuildResult, Error> {
     let mut timings = Vec::new();
     let t0 = Instant::now();
+    crate::consistency::check_model(model)?;
     let ctx = Ctx::new(model, s)?;
     let fe_mass = ctx.checks(s)?;
     timings.push(("checks".to_string(), t0.elapsed().as_secs_f64()));

@@ -24,6 +24,38 @@ pub enum Error {
         /// What is wrong.
         msg: String,
     },
+    /// A file ends early, or lacks entries that every complete file of its
+    /// kind has (line: the last line read, 0 if not known).
+    #[error("{file}:{line}: truncated or incomplete: {msg}")]
+    Truncated {
+        /// The file.
+        file: String,
+        /// 1-based line number (0 if not known).
+        line: usize,
+        /// What is missing.
+        msg: String,
+    },
+    /// Input files that do not belong together: K, M, the DOF list and the
+    /// mesh (the message names the file at fault).
+    #[error("mismatched input files: {0}")]
+    Mismatch(String),
+    /// A matrix entry that no stiffness or mass of a solid can have (a
+    /// non-positive or missing diagonal).
+    #[error("{file}: {msg}")]
+    Matrix {
+        /// The file (or "K" / "M" when not read from a file).
+        file: String,
+        /// What is wrong, naming the equation, node and direction.
+        msg: String,
+    },
+    /// A file could not be written.
+    #[error("cannot write {path}: {source}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
     /// Matrix or vector sizes do not agree.
     #[error("size mismatch: {0}")]
     SizeMismatch(String),
@@ -88,6 +120,19 @@ impl Error {
             source,
         }
     }
+    pub(crate) fn write(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Write {
+            path: path.into(),
+            source,
+        }
+    }
+    pub(crate) fn truncated(file: &str, line: usize, msg: impl Into<String>) -> Self {
+        Error::Truncated {
+            file: file.to_string(),
+            line,
+            msg: msg.into(),
+        }
+    }
     pub(crate) fn parse(file: &str, line: usize, msg: impl Into<String>) -> Self {
         Error::Parse {
             file: file.to_string(),
@@ -100,5 +145,15 @@ impl Error {
             side: side.to_string(),
             msg: msg.into(),
         }
+    }
+
+    /// Whether the error lies in the input (files, specification, model
+    /// data: exit code 2 on the command line) rather than in a computation or
+    /// in writing the output (exit code 1).
+    pub fn is_input(&self) -> bool {
+        !matches!(
+            self,
+            Error::Solver(_) | Error::Write { .. } | Error::Element(_)
+        )
     }
 }

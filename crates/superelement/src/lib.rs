@@ -15,7 +15,11 @@
 //! * [`solid`]: a built-in 20-node hexahedral solid FE and structured mesher,
 //!   [`parts`]: the thesis's parts (prismatic bar, short sheet flexure, unbalanced
 //!   shaft, thin-walled box arm).
-//! * [`readers`]: Matrix Market and CalculiX (`.sti`, `.mas`, `.dof`, `.inp`).
+//! * [`readers`]: Matrix Market and CalculiX (`.sti`, `.mas`, `.dof`, `.inp`),
+//!   with truncated files and mismatched equation counts named;
+//!   [`consistency`]: the checks of K, M, the DOF list and the mesh against
+//!   each other that [`build`] runs first; [`geometry`]: volume moments of
+//!   solid elements for its rigid-body check.
 //! * [`spec`]: a RON specification and [`build_from_spec`], the function behind
 //!   `flexmb build-superelement SPEC.ron`.
 //!
@@ -40,7 +44,9 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 mod builder;
+pub mod consistency;
 mod error;
+pub mod geometry;
 pub mod linalg;
 mod model;
 pub mod parts;
@@ -56,5 +62,5 @@ pub use builder::{
     InterfacePattern, PointMass, RigidBodyProperties, RigidMotion, VE_INDEX,
 };
 pub use error::Error;
-pub use model::{DofMap, FeModel, NodeSelection};
+pub use model::{DofMap, FeModel, NodeSelection, ReferenceMass, SolidElements, Sources};
 pub use spec::{build_from_spec, BuildOutput, ModelSource, Spec};

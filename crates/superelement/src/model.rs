@@ -7,6 +7,7 @@
 //! (with the diagonal); [`FeModel::new`] accepts upper, lower or full storage and
 //! canonicalizes it, checking the symmetry of full input.
 
+use crate::geometry::SolidKind;
 use crate::Error;
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use faer::{MatMut, MatRef};
@@ -76,6 +77,74 @@ impl DofMap {
     }
 }
 
+/// Where K, M, the DOF list and the node coordinates were read from, so that
+/// a message can name the file at fault (empty when not read from a file).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Sources {
+    /// The stiffness file.
+    pub k: String,
+    /// The mass file.
+    pub m: String,
+    /// The DOF list (CalculiX `.dof` or its Matrix Market counterpart).
+    pub dofs: String,
+    /// The node coordinates (the `.inp` mesh or the node file).
+    pub mesh: String,
+}
+
+impl Sources {
+    fn name(what: &str, file: &str) -> String {
+        if file.is_empty() {
+            what.to_string()
+        } else {
+            format!("{what} ({file})")
+        }
+    }
+    /// "K (job.sti)", or "K".
+    pub fn k_name(&self) -> String {
+        Self::name("K", &self.k)
+    }
+    /// "M (job.mas)", or "M".
+    pub fn m_name(&self) -> String {
+        Self::name("M", &self.m)
+    }
+    /// "the DOF list (job.dof)", or "the DOF list".
+    pub fn dofs_name(&self) -> String {
+        Self::name("the DOF list", &self.dofs)
+    }
+    /// "the mesh (job.inp)", or "the mesh".
+    pub fn mesh_name(&self) -> String {
+        Self::name("the mesh", &self.mesh)
+    }
+}
+
+/// The solid elements K and M were assembled on (node indices of the model)
+/// with their densities: the sparsity check and the rigid-body check of M
+/// compare with them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolidElements {
+    /// Element types.
+    pub kinds: Vec<SolidKind>,
+    /// Node indices (into the model's nodes) per element, in the type's order.
+    pub nodes: Vec<Vec<usize>>,
+    /// Density (kg/m³) per element, where known.
+    pub density: Vec<Option<f64>>,
+    /// Where the densities come from (for messages), e.g. "*DENSITY in job.inp".
+    pub density_source: String,
+    /// Keywords of the deck that couple nodes outside the elements (*EQUATION,
+    /// *TIE, …) with their file and line; with any, M may couple nodes that
+    /// share no element and the sparsity is checked against K instead.
+    pub couplings: Vec<String>,
+}
+
+/// A mass the part must have (from a given volume and density).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceMass {
+    /// Mass (kg).
+    pub mass: f64,
+    /// Where it comes from, e.g. "volume 1e-5 m³ × density 7800 kg/m³ of the spec".
+    pub what: String,
+}
+
 /// A linear FE model of a part.
 #[derive(Clone, Debug)]
 pub struct FeModel {
@@ -89,6 +158,13 @@ pub struct FeModel {
     m: SparseColMat<usize, f64>,
     /// The mesh volume (m³), if known (used for the density plausibility check).
     pub volume: Option<f64>,
+    /// The files the model was read from (for messages).
+    pub sources: Sources,
+    /// The solid elements, if known (sparsity and rigid-body checks).
+    pub solid: Option<SolidElements>,
+    /// A mass the part must have, if known without elements (Matrix Market
+    /// input with a volume and a density).
+    pub reference_mass: Option<ReferenceMass>,
 }
 
 impl FeModel {
@@ -157,6 +233,9 @@ impl FeModel {
             k,
             m,
             volume: None,
+            sources: Sources::default(),
+            solid: None,
+            reference_mass: None,
         })
     }
 
@@ -196,6 +275,26 @@ impl FeModel {
     pub fn describe_eq(&self, e: usize) -> String {
         let (nd, d) = self.dofs.dof(e);
         format!("node {} {}", self.node_ids[nd], DIR[d as usize])
+    }
+    /// "equation 13 (node N uy)" for equation e (numbered from 1, as in the
+    /// files).
+    pub fn describe_eq_long(&self, e: usize) -> String {
+        format!("equation {} ({})", e + 1, self.describe_eq(e))
+    }
+
+    /// Checks K and M against each other, the node coordinates and the mesh
+    /// (diagonals, swapped files, rigid null space, sparsity, rigid-body mass
+    /// and inertia; see the `consistency` checks in the crate documentation).
+    /// [`crate::build`] runs this first; the error names the file at fault.
+    pub fn check_consistency(&self) -> Result<(), Error> {
+        crate::consistency::check_model(self)
+    }
+
+    /// M's rigid-body mass, centre of mass and inertia against those of the
+    /// solid elements' volume × density (the last of the consistency
+    /// checks); `None` unless the elements and all their densities are known.
+    pub fn compare_rigid_body(&self) -> Option<crate::consistency::RigidBodyComparison> {
+        crate::consistency::compare_rigid_body(self)
     }
 
     /// The mass for a unit rigid translation along each global axis, uᵀ M u.

@@ -10,7 +10,8 @@
 //!   or the deck that `*INCLUDE`s it (as written by `gmsh -format inp`).
 //!   DOFs removed by *BOUNDARY / *EQUATION are absent from all three files.
 
-use crate::model::{DofMap, FeModel};
+use crate::geometry::{Integrator, SolidKind};
+use crate::model::{DofMap, FeModel, SolidElements, Sources};
 use crate::Error;
 use faer::sparse::{SparseColMat, SparseColMatRef};
 use std::collections::HashMap;
@@ -35,6 +36,7 @@ pub fn read_matrix_market(path: &Path) -> Result<SparseColMat<usize, f64>, Error
 
 /// Parses Matrix Market text (see [`read_matrix_market`]).
 pub fn parse_matrix_market(text: &str, file: &str) -> Result<SparseColMat<usize, f64>, Error> {
+    check_not_cut_off(text, file)?;
     let mut lines = text.lines().enumerate();
     let (_, header) = lines
         .next()
@@ -76,6 +78,8 @@ pub fn parse_matrix_market(text: &str, file: &str) -> Result<SparseColMat<usize,
         }
     };
     let mut size: Option<(usize, usize, usize)> = None;
+    let mut size_line = 0;
+    let mut last_line = 0;
     let mut trip = Vec::new();
     for (ln, line) in lines {
         let t = line.trim();
@@ -97,9 +101,21 @@ pub fn parse_matrix_market(text: &str, file: &str) -> Result<SparseColMat<usize,
                         .map_err(|_| Error::parse(file, ln + 1, format!("'{s}' is not a count")))
                 };
                 size = Some((p(f[0])?, p(f[1])?, p(f[2])?));
-                trip.reserve(p(f[2])?);
+                size_line = ln + 1;
+                // no more than the text can hold (a wrong count must not exhaust memory)
+                trip.reserve(p(f[2])?.min(text.len() / 6));
             }
-            Some((nr, nc, _)) => {
+            Some((nr, nc, nnz)) => {
+                if trip.len() == nnz {
+                    return Err(Error::parse(
+                        file,
+                        ln + 1,
+                        format!(
+                            "more entries than the {nnz} the size line (line {size_line}) declares: '{t}'"
+                        ),
+                    ));
+                }
+                last_line = ln + 1;
                 let (i, j, v) = parse_triplet(&f, t, file, ln + 1)?;
                 if i == 0 || j == 0 || i > nr || j > nc {
                     return Err(Error::parse(
@@ -113,12 +129,12 @@ pub fn parse_matrix_market(text: &str, file: &str) -> Result<SparseColMat<usize,
         }
     }
     let (nr, nc, nnz) = size.ok_or_else(|| Error::parse(file, 0, "no size line"))?;
-    if trip.len() != nnz {
-        return Err(Error::parse(
+    if trip.len() < nnz {
+        return Err(Error::truncated(
             file,
-            0,
+            last_line.max(size_line),
             format!(
-                "the size line declares {nnz} entries but the file has {}",
+                "the size line (line {size_line}) declares {nnz} entries, but the file ends after {}",
                 trip.len()
             ),
         ));
@@ -215,8 +231,8 @@ pub fn write_matrix_market_dense(path: &Path, a: &nalgebra::DMatrix<f64>) -> Res
 }
 
 pub(crate) fn write_file(path: &Path, s: &str) -> Result<(), Error> {
-    let mut f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-    f.write_all(s.as_bytes()).map_err(|e| Error::io(path, e))
+    let mut f = std::fs::File::create(path).map_err(|e| Error::write(path, e))?;
+    f.write_all(s.as_bytes()).map_err(|e| Error::write(path, e))
 }
 
 /// Reads a node file: one `label x y z` per line (whitespace or commas; `#`,
@@ -269,6 +285,45 @@ pub fn write_nodes(path: &Path, ids: &[u64], coords: &[[f64; 3]]) -> Result<(), 
 /// Parses CalculiX `.dof` text: one `node.dir` per equation. Returns (node
 /// label, direction 0..3) per equation.
 pub fn parse_calculix_dof(text: &str, file: &str) -> Result<Vec<(u64, u8)>, Error> {
+    parse_dof_lines(text, file).map_err(|e| cut_off_or(text, file, e))
+}
+
+/// Takes a syntax error on the last line of a text that does not end with an
+/// end of line for what it is: the file was cut off.
+fn cut_off_or(text: &str, file: &str, e: Error) -> Error {
+    let last = text.lines().count();
+    match &e {
+        Error::Parse { line, .. } if *line == last && !text.ends_with('\n') => Error::truncated(
+            file,
+            last,
+            format!(
+                "the last line, '{}', is cut off (it has no end of line and cannot be read): {e}",
+                text.lines().last().unwrap_or("").trim()
+            ),
+        ),
+        _ => e,
+    }
+}
+
+/// Errors if `text` does not end with an end of line: every line CalculiX
+/// and Matrix Market writers write ends with one, and a value cut short can
+/// still be read as a number (`1.2345678901234e+07` → `1.2345678901234e+0`).
+fn check_not_cut_off(text: &str, file: &str) -> Result<(), Error> {
+    if text.is_empty() || text.ends_with('\n') {
+        return Ok(());
+    }
+    Err(Error::truncated(
+        file,
+        text.lines().count(),
+        format!(
+            "the last line, '{}', has no end of line: the file was cut off (if it is complete, end it with a \
+             line break)",
+            text.lines().last().unwrap_or("").trim()
+        ),
+    ))
+}
+
+fn parse_dof_lines(text: &str, file: &str) -> Result<Vec<(u64, u8)>, Error> {
     let mut out = Vec::new();
     for (ln, line) in text.lines().enumerate() {
         let t = line.trim();
@@ -302,32 +357,176 @@ pub fn parse_calculix_dof(text: &str, file: &str) -> Result<Vec<(u64, u8)>, Erro
     Ok(out)
 }
 
-/// Parses CalculiX `.sti` / `.mas` text: `row col value`, 1-based.
+/// Parses CalculiX `.sti` / `.mas` text: `row col value`, 1-based, over the
+/// `n` equations of the `.dof` list. Errors if the file is cut off, has an
+/// index above `n`, stops before equation `n` or lacks a diagonal entry in
+/// the column it ends in (truncated; CalculiX ends every column with its
+/// diagonal).
 pub fn parse_calculix_matrix(
     text: &str,
     file: &str,
     n: usize,
 ) -> Result<SparseColMat<usize, f64>, Error> {
-    let mut trip = Vec::new();
-    for (ln, line) in text.lines().enumerate() {
-        let t = line.trim();
-        if t.is_empty() {
-            continue;
+    let raw = CcxMatrix::parse(text, file)?;
+    if raw.max > n {
+        return Err(Error::Mismatch(format!(
+            "{file}:{} has an entry for equation {}, but the .dof file lists {n} equations",
+            raw.max_line, raw.max
+        )));
+    }
+    if raw.max < n {
+        return Err(raw.stops_early(n, "the .dof file", None));
+    }
+    raw.check_last_column()?;
+    raw.into_csc(n)
+}
+
+/// A CalculiX `.sti` / `.mas` file as read, before it is checked against the
+/// `.dof` list and the other matrix: the entries (1-based; zero off-diagonal
+/// entries dropped, zero diagonals kept for the diagonal check) and where the
+/// file ends.
+struct CcxMatrix {
+    file: String,
+    entries: Vec<(usize, usize, f64)>,
+    /// The largest index, and the line of its first appearance.
+    max: usize,
+    max_line: usize,
+    /// The line and (row, column) of the last entry.
+    last: Option<(usize, usize, usize)>,
+}
+
+impl CcxMatrix {
+    /// Reads the entries; errors on syntax, a 0 index and a cut-off last line.
+    fn parse(text: &str, file: &str) -> Result<Self, Error> {
+        check_not_cut_off(text, file)?;
+        let mut out = CcxMatrix {
+            file: file.to_string(),
+            entries: Vec::new(),
+            max: 0,
+            max_line: 0,
+            last: None,
+        };
+        for (ln, line) in text.lines().enumerate() {
+            let t = line.trim();
+            if t.is_empty() {
+                continue;
+            }
+            let f: Vec<&str> = t.split_whitespace().collect();
+            let (i, j, v) = parse_triplet(&f, t, file, ln + 1)?;
+            if i == 0 || j == 0 {
+                return Err(Error::parse(
+                    file,
+                    ln + 1,
+                    format!("index ({i}, {j}): CalculiX indices start at 1"),
+                ));
+            }
+            if i.max(j) > out.max {
+                out.max = i.max(j);
+                out.max_line = ln + 1;
+            }
+            out.last = Some((ln + 1, i, j));
+            if v != 0.0 || i == j {
+                out.entries.push((i, j, v));
+            }
         }
-        let f: Vec<&str> = t.split_whitespace().collect();
-        let (i, j, v) = parse_triplet(&f, t, file, ln + 1)?;
-        if i == 0 || j == 0 || i > n || j > n {
-            return Err(Error::parse(
-                file,
-                ln + 1,
-                format!("index ({i}, {j}) outside 1..{n} (the .dof file lists {n} equations)"),
-            ));
-        }
-        if v != 0.0 {
-            trip.push((i - 1, j - 1, v));
+        Ok(out)
+    }
+
+    /// The error for a file whose entries stop at equation `max` < `n`, where
+    /// `n` comes from `dof_file` (and `other`, the other matrix, agrees): a
+    /// complete matrix of a smaller model if it ends with the diagonal of its
+    /// last equation, truncated otherwise.
+    fn stops_early(&self, n: usize, dof_file: &str, other: Option<&str>) -> Error {
+        let also = other
+            .map(|o| format!(" and {o} has entries up to equation {n}"))
+            .unwrap_or_default();
+        match self.last {
+            None => Error::truncated(
+                &self.file,
+                0,
+                format!("the file has no entries, but {dof_file} lists {n} equations"),
+            ),
+            Some((line, i, j)) if i == j && j == self.max => Error::Mismatch(format!(
+                "{} holds a matrix of {} equations (it ends with the diagonal entry of equation {} at line \
+                 {line}), but {dof_file} lists {n} equations{also}: {} is from another model with fewer \
+                  equations (or was cut off exactly after that line)",
+                self.file, self.max, self.max, self.file
+            )),
+            Some((line, i, j)) => Error::truncated(
+                &self.file,
+                line,
+                format!(
+                    "the file ends with the entry ({i}, {j}) and has entries up to equation {} only, but \
+                     {dof_file} lists {n} equations{also}",
+                    self.max
+                ),
+            ),
         }
     }
-    to_csc(n, n, trip, file)
+
+    /// Errors if the column of the last entry has no diagonal entry: the file
+    /// was cut inside that column (CalculiX ends every column with its
+    /// diagonal).
+    fn check_last_column(&self) -> Result<(), Error> {
+        let Some((line, i, j)) = self.last else {
+            return Ok(());
+        };
+        if i == j || self.entries.iter().any(|&(a, b, _)| a == j && b == j) {
+            return Ok(());
+        }
+        Err(Error::truncated(
+            &self.file,
+            line,
+            format!(
+                "the file ends with the entry ({i}, {j}), inside the column of equation {j} before its diagonal \
+                 entry ({j}, {j}); CalculiX ends every column with its diagonal"
+            ),
+        ))
+    }
+
+    fn into_csc(self, n: usize) -> Result<SparseColMat<usize, f64>, Error> {
+        let trip = self
+            .entries
+            .into_iter()
+            .map(|(i, j, v)| (i - 1, j - 1, v))
+            .collect();
+        to_csc(n, n, trip, &self.file)
+    }
+}
+
+/// Checks the equation counts of `.sti`, `.mas` and `.dof` against each other
+/// (the largest index of each matrix must be the number of `.dof` entries)
+/// and names the file that disagrees with the other two.
+fn check_equation_counts(k: &CcxMatrix, m: &CcxMatrix, n: usize, dof: &str) -> Result<(), Error> {
+    match (k.max == n, m.max == n) {
+        (true, true) => Ok(()),
+        (true, false) => Err(one_count_off(m, k, n, dof)),
+        (false, true) => Err(one_count_off(k, m, n, dof)),
+        (false, false) if k.max == m.max => Err(Error::Mismatch(format!(
+            "{dof} lists {n} equations, but {} and {} both have entries up to equation {} ({}:{}, {}:{}): {dof} \
+             is from another model (or truncated)",
+            k.file, m.file, k.max, k.file, k.max_line, m.file, m.max_line
+        ))),
+        (false, false) => Err(Error::Mismatch(format!(
+            "{dof} lists {n} equations, {} has entries up to equation {} (line {}) and {} up to {} (line {}): the \
+             three files come from different models (or are truncated)",
+            k.file, k.max, k.max_line, m.file, m.max, m.max_line
+        ))),
+    }
+}
+
+/// The error for `bad`, whose largest index differs from the `n` of the
+/// `.dof` list while `good` agrees with it.
+fn one_count_off(bad: &CcxMatrix, good: &CcxMatrix, n: usize, dof: &str) -> Error {
+    if bad.max > n {
+        Error::Mismatch(format!(
+            "{}:{} has an entry for equation {}, but {dof} lists {n} equations and {} has entries up to \
+             equation {n}: {} is from another model with more equations",
+            bad.file, bad.max_line, bad.max, good.file, bad.file
+        ))
+    } else {
+        bad.stops_early(n, dof, Some(&good.file))
+    }
 }
 
 /// Nodes and solid elements of an Abaqus/CalculiX `.inp` mesh.
@@ -344,60 +543,109 @@ pub struct InpMesh {
     /// The files read: the `.inp` and the files it `*INCLUDE`s (empty when
     /// parsed from text).
     pub files: Vec<PathBuf>,
+    /// Element labels, parallel to [`InpMesh::elements`].
+    pub element_ids: Vec<u64>,
+    /// Element sets (*ELSET and `ELSET=` of *ELEMENT) by upper-case name:
+    /// element labels.
+    pub elsets: HashMap<String, Vec<u64>>,
+    /// Densities of the materials (*MATERIAL, NAME= … *DENSITY) by upper-case
+    /// name: the values of the *DENSITY data lines (one per temperature).
+    pub densities: HashMap<String, Vec<f64>>,
+    /// Solid sections (*SOLID SECTION): (element set, material), upper case.
+    pub solid_sections: Vec<(String, String)>,
+    /// Keywords that couple nodes outside the elements (*EQUATION, *MPC,
+    /// *TIE, *RIGID BODY, *COUPLING, *CONTACT PAIR, …), each with its file
+    /// and line.
+    pub couplings: Vec<String>,
 }
 
 impl InpMesh {
-    /// Volume of the solid elements from their corner nodes (straight-edged
-    /// tetrahedral decomposition; for the units check).
+    /// Volume of the solid elements (C3D4/10, C3D8/20, C3D6/15 and variants)
+    /// over their isoparametric geometry (for the units check); `None`
+    /// without solid elements.
     pub fn volume(&self) -> Option<f64> {
-        let idx: HashMap<u64, usize> = self
-            .ids
-            .iter()
-            .enumerate()
-            .map(|(i, &id)| (id, i))
-            .collect();
-        let tet = |a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]| {
-            let u = crate::model::sub(b, a);
-            let v = crate::model::sub(c, a);
-            let w = crate::model::sub(d, a);
-            (crate::model::dot(u, crate::model::cross(v, w)) / 6.0).abs()
-        };
+        let idx = self.node_index();
+        let mut integrator = Integrator::default();
         let mut vol = 0.0;
         let mut any = false;
         for (ty, nodes) in &self.elements {
-            let p: Option<Vec<[f64; 3]>> = nodes
+            let Some(kind) = SolidKind::from_type(ty) else {
+                continue;
+            };
+            let x: Option<Vec<[f64; 3]>> = nodes
                 .iter()
                 .map(|n| idx.get(n).map(|&i| self.coords[i]))
                 .collect();
-            let Some(p) = p else { continue };
-            let t = ty.to_ascii_uppercase();
-            let v = if t.starts_with("C3D4") || t.starts_with("C3D10") {
-                tet(p[0], p[1], p[2], p[3])
-            } else if t.starts_with("C3D8") || t.starts_with("C3D20") {
-                // split the hexahedron into 6 tetrahedra around the diagonal 0–6
-                [
-                    [0, 1, 2, 6],
-                    [0, 2, 3, 6],
-                    [0, 3, 7, 6],
-                    [0, 7, 4, 6],
-                    [0, 4, 5, 6],
-                    [0, 5, 1, 6],
-                ]
-                .iter()
-                .map(|q| tet(p[q[0]], p[q[1]], p[q[2]], p[q[3]]))
-                .sum()
-            } else if t.starts_with("C3D6") || t.starts_with("C3D15") {
-                tet(p[0], p[1], p[2], p[3])
-                    + tet(p[1], p[2], p[3], p[4])
-                    + tet(p[2], p[3], p[4], p[5])
-            } else {
+            let Some(m) = x.and_then(|x| integrator.moments(kind, &x, x[0])) else {
                 continue;
             };
             any = true;
-            vol += v;
+            vol += m.volume;
         }
         any.then_some(vol)
     }
+
+    /// Node label → index into [`InpMesh::ids`].
+    fn node_index(&self) -> HashMap<u64, usize> {
+        self.ids
+            .iter()
+            .enumerate()
+            .map(|(i, &id)| (id, i))
+            .collect()
+    }
+
+    /// The density of each element (parallel to [`InpMesh::elements`]) from
+    /// the *SOLID SECTION covering it and its material's *DENSITY; `None`
+    /// where there is no section, the material has no density, or the density
+    /// depends on temperature (several data lines).
+    pub fn element_densities(&self) -> Vec<Option<f64>> {
+        let mut of: HashMap<u64, Option<f64>> = HashMap::new();
+        for (elset, material) in &self.solid_sections {
+            let rho = match self.densities.get(material).map(|v| v.as_slice()) {
+                Some(&[r]) => Some(r),
+                _ => None,
+            };
+            for &e in self.elsets.get(elset).map(|v| v.as_slice()).unwrap_or(&[]) {
+                of.insert(e, rho);
+            }
+        }
+        self.element_ids
+            .iter()
+            .map(|e| of.get(e).copied().flatten())
+            .collect()
+    }
+}
+
+/// The most labels one `GENERATE` line may produce (more is taken for a
+/// typo, not expanded until memory runs out).
+const MAX_GENERATED: u64 = 10_000_000;
+
+/// The labels of a `GENERATE` data line `first, last[, step]` of *NSET or
+/// *ELSET.
+fn generated(nums: &[u64], file: &str, line: usize) -> Result<Vec<u64>, Error> {
+    let (a, b, step) = match *nums {
+        [a] => (a, a, 1),
+        [a, b] => (a, b, 1),
+        [a, b, st] => (a, b, st),
+        _ => {
+            return Err(Error::parse(
+                file,
+                line,
+                format!("GENERATE expects 'first, last[, step]', got {nums:?}"),
+            ))
+        }
+    };
+    if b < a || step == 0 || (b - a) / step >= MAX_GENERATED {
+        return Err(Error::parse(
+            file,
+            line,
+            format!(
+                "GENERATE range {a}, {b}, {step}: needs first ≤ last, a step ≥ 1 and at most \
+                 {MAX_GENERATED} labels"
+            ),
+        ));
+    }
+    Ok((a..=b).step_by(step as usize).collect())
 }
 
 /// How deep `*INCLUDE`s may nest (deeper is taken for a cycle).
@@ -407,9 +655,27 @@ const MAX_INCLUDE_DEPTH: usize = 16;
 enum Block {
     None,
     Node,
-    Element(String),
+    /// Element type (upper case) and the `ELSET=` it goes to.
+    Element(String, Option<String>),
     Nset(String, bool),
+    /// Element set name and whether it is `GENERATE`d.
+    Elset(String, bool),
+    /// *DENSITY of the named material.
+    Density(String),
 }
+
+/// Keywords that couple nodes outside the elements (the mass then couples
+/// nodes that share no element).
+const COUPLING_KEYWORDS: [&str; 8] = [
+    "*EQUATION",
+    "*MPC",
+    "*TIE",
+    "*RIGID BODY",
+    "*COUPLING",
+    "*KINEMATIC COUPLING",
+    "*DISTRIBUTING COUPLING",
+    "*CONTACT PAIR",
+];
 
 /// The state of the `.inp` parser, kept across `*INCLUDE`d files (an include
 /// is textual: a block may continue into or out of the included file).
@@ -418,23 +684,10 @@ struct InpParser {
     block: Block,
     pending: Vec<u64>,
     pending_at: (String, usize),
-}
-
-/// Nodes per solid element type (C3D4, C3D10, C3D8, C3D20, C3D6, C3D15 and
-/// their variants such as C3D10T, C3D20R); `None` for other types.
-fn solid_element_nodes(ty: &str) -> Option<usize> {
-    // longest prefixes first: C3D10 before C3D1, C3D20 before C3D2
-    [
-        ("C3D10", 10),
-        ("C3D15", 15),
-        ("C3D20", 20),
-        ("C3D4", 4),
-        ("C3D6", 6),
-        ("C3D8", 8),
-    ]
-    .iter()
-    .find(|(p, _)| ty.starts_with(p))
-    .map(|&(_, n)| n)
+    /// The current *MATERIAL (upper case).
+    material: Option<String>,
+    /// Element sets named inside other element sets: (set, member set).
+    elset_refs: Vec<(String, String)>,
 }
 
 impl InpParser {
@@ -444,6 +697,8 @@ impl InpParser {
             block: Block::None,
             pending: Vec::new(),
             pending_at: (String::new(), 0),
+            material: None,
+            elset_refs: Vec::new(),
         }
     }
 
@@ -488,14 +743,34 @@ impl InpParser {
                     continue;
                 }
                 self.check_no_pending("element definition continues past the block")?;
+                let upper = |key: &str| param(key).map(|v| v.to_ascii_uppercase());
+                let gen = kw[1..].iter().any(|p| p.eq_ignore_ascii_case("GENERATE"));
+                if COUPLING_KEYWORDS.iter().any(|k| name.starts_with(k)) {
+                    self.mesh
+                        .couplings
+                        .push(format!("{name} at {file}:{}", ln + 1));
+                }
                 self.block = match name.as_str() {
                     "*NODE" => Block::Node,
-                    "*ELEMENT" => {
-                        Block::Element(param("TYPE").unwrap_or_default().to_ascii_uppercase())
+                    "*ELEMENT" => Block::Element(upper("TYPE").unwrap_or_default(), upper("ELSET")),
+                    "*NSET" => Block::Nset(upper("NSET").unwrap_or_default(), gen),
+                    "*ELSET" => Block::Elset(upper("ELSET").unwrap_or_default(), gen),
+                    "*MATERIAL" => {
+                        self.material = upper("NAME");
+                        Block::None
                     }
-                    "*NSET" => {
-                        let gen = kw[1..].iter().any(|p| p.eq_ignore_ascii_case("GENERATE"));
-                        Block::Nset(param("NSET").unwrap_or_default().to_ascii_uppercase(), gen)
+                    "*DENSITY" => match &self.material {
+                        Some(m) => {
+                            self.mesh.densities.insert(m.clone(), Vec::new());
+                            Block::Density(m.clone())
+                        }
+                        None => Block::None,
+                    },
+                    "*SOLID SECTION" => {
+                        if let (Some(e), Some(m)) = (upper("ELSET"), upper("MATERIAL")) {
+                            self.mesh.solid_sections.push((e, m));
+                        }
+                        Block::None
                     }
                     _ => Block::None,
                 };
@@ -528,12 +803,13 @@ impl InpParser {
                     self.mesh.ids.push(id);
                     self.mesh.coords.push(x);
                 }
-                Block::Element(ty) => {
+                Block::Element(ty, elset) => {
                     // other element types (gmsh writes lines and faces too
                     // when no physical groups are defined) are skipped
-                    let Some(n) = solid_element_nodes(ty) else {
+                    let Some(n) = SolidKind::from_type(ty).map(SolidKind::n_nodes) else {
                         continue;
                     };
+                    let elset = elset.clone();
                     if self.pending.is_empty() {
                         self.pending_at = (file.to_string(), ln + 1);
                     }
@@ -557,8 +833,26 @@ impl InpParser {
                         ));
                     }
                     let nodes = self.pending[1..].to_vec();
+                    let id = self.pending[0];
                     self.mesh.elements.push((ty.clone(), nodes));
+                    self.mesh.element_ids.push(id);
+                    if let Some(set) = elset {
+                        self.mesh.elsets.entry(set).or_default().push(id);
+                    }
                     self.pending.clear();
+                }
+                Block::Elset(name, generate) => {
+                    let set = name.clone();
+                    let generate = *generate;
+                    self.elset_line(&set, generate, &f, file, ln + 1)?;
+                }
+                Block::Density(material) => {
+                    // the first value of each data line (the others are temperatures)
+                    if let Some(v) = f.first().and_then(|s| parse_f64(s)) {
+                        if let Some(d) = self.mesh.densities.get_mut(material) {
+                            d.push(v);
+                        }
+                    }
                 }
                 Block::Nset(name, generate) => {
                     let nums: Vec<u64> = f
@@ -569,22 +863,60 @@ impl InpParser {
                             })
                         })
                         .collect::<Result<_, _>>()?;
-                    let set = self.mesh.nsets.entry(name.clone()).or_default();
-                    if *generate {
-                        let (a, b, st) = (
-                            nums[0],
-                            *nums.get(1).unwrap_or(&nums[0]),
-                            *nums.get(2).unwrap_or(&1),
-                        );
-                        let mut k = a;
-                        while k <= b {
-                            set.push(k);
-                            k += st.max(1);
-                        }
+                    let labels = if *generate {
+                        generated(&nums, file, ln + 1)?
                     } else {
-                        set.extend(nums);
-                    }
+                        nums
+                    };
+                    self.mesh
+                        .nsets
+                        .entry(name.clone())
+                        .or_default()
+                        .extend(labels);
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// One data line of *ELSET: element labels (`first, last, step` with
+    /// `GENERATE`) or names of other element sets.
+    fn elset_line(
+        &mut self,
+        set: &str,
+        generate: bool,
+        f: &[&str],
+        file: &str,
+        line: usize,
+    ) -> Result<(), Error> {
+        let nums: Vec<Option<u64>> = f.iter().map(|s| s.parse().ok()).collect();
+        if generate {
+            let n: Vec<u64> = nums.iter().map_while(|x| *x).collect();
+            if n.len() != nums.len() {
+                return Err(Error::parse(
+                    file,
+                    line,
+                    format!(
+                        "*ELSET, GENERATE expects 'first, last[, step]', got '{}'",
+                        f.join(", ")
+                    ),
+                ));
+            }
+            let labels = generated(&n, file, line)?;
+            self.mesh
+                .elsets
+                .entry(set.to_string())
+                .or_default()
+                .extend(labels);
+            return Ok(());
+        }
+        let entry = self.mesh.elsets.entry(set.to_string()).or_default();
+        for (s, n) in f.iter().zip(nums) {
+            match n {
+                Some(n) => entry.push(n),
+                None => self
+                    .elset_refs
+                    .push((set.to_string(), s.to_ascii_uppercase())),
             }
         }
         Ok(())
@@ -625,10 +957,26 @@ impl InpParser {
         self.feed(&text, &fname(&path), Some(&sub_dir), depth + 1)
     }
 
-    fn finish(self, file: &str) -> Result<InpMesh, Error> {
+    fn finish(mut self, file: &str) -> Result<InpMesh, Error> {
         self.check_no_pending("incomplete element definition at the end of the file")?;
         if self.mesh.ids.is_empty() {
             return Err(Error::parse(file, 0, "no *NODE block"));
+        }
+        // element sets named in other sets, nested at most MAX_INCLUDE_DEPTH deep
+        for _ in 0..MAX_INCLUDE_DEPTH {
+            let mut changed = false;
+            for (set, member) in &self.elset_refs {
+                let add = self.mesh.elsets.get(member).cloned().unwrap_or_default();
+                let to = self.mesh.elsets.entry(set.clone()).or_default();
+                let before = to.len();
+                to.extend(add);
+                to.sort_unstable();
+                to.dedup();
+                changed |= to.len() != before;
+            }
+            if !changed {
+                break;
+            }
         }
         Ok(self.mesh)
     }
@@ -691,8 +1039,12 @@ fn calculix_from_mesh(
 ) -> Result<(FeModel, InpMesh), Error> {
     let dofs = parse_calculix_dof(dof, dof_name)?;
     let n = dofs.len();
-    let k = parse_calculix_matrix(sti, sti_name, n)?;
-    let m = parse_calculix_matrix(mas, mas_name, n)?;
+    let k = CcxMatrix::parse(sti, sti_name)?;
+    let m = CcxMatrix::parse(mas, mas_name)?;
+    check_equation_counts(&k, &m, n, dof_name)?;
+    k.check_last_column()?;
+    m.check_last_column()?;
+    let (k, m) = (k.into_csc(n)?, m.into_csc(n)?);
     let (ids, coords) = if mesh.elements.is_empty() {
         (mesh.ids.clone(), mesh.coords.clone())
     } else {
@@ -711,7 +1063,45 @@ fn calculix_from_mesh(
     };
     let mut model = model_from_parts(name, ids, coords, &dofs, k, m, dof_name)?;
     model.volume = mesh.volume();
+    let deck = mesh
+        .files
+        .first()
+        .map(|p| fname(p))
+        .unwrap_or_else(|| format!("{name}.inp"));
+    model.sources = Sources {
+        k: sti_name.to_string(),
+        m: mas_name.to_string(),
+        dofs: dof_name.to_string(),
+        mesh: deck.clone(),
+    };
+    model.solid = Some(solid_elements(&model, &mesh, &deck));
     Ok((model, mesh))
+}
+
+/// The solid elements of `mesh` over the nodes of `model`, with the densities
+/// of the deck's *SOLID SECTION / *DENSITY.
+fn solid_elements(model: &FeModel, mesh: &InpMesh, deck: &str) -> SolidElements {
+    let mut out = SolidElements {
+        density_source: format!("*DENSITY in {deck}"),
+        couplings: mesh.couplings.clone(),
+        ..Default::default()
+    };
+    for ((ty, nodes), rho) in mesh.elements.iter().zip(mesh.element_densities()) {
+        let Some(kind) = SolidKind::from_type(ty) else {
+            continue;
+        };
+        let Some(idx) = nodes
+            .iter()
+            .map(|&n| model.node_index(n))
+            .collect::<Option<Vec<usize>>>()
+        else {
+            continue;
+        };
+        out.kinds.push(kind);
+        out.nodes.push(idx);
+        out.density.push(rho);
+    }
+    out
 }
 
 /// Parses a CalculiX export set given as text (the same as [`read_calculix`],
@@ -782,5 +1172,51 @@ pub fn read_matrix_market_model(
             .collect(),
     };
     let df = dofs.map(fname).unwrap_or_else(|| fname(nodes));
-    model_from_parts(name, ids, coords, &dl, kk, mm, &df)
+    let (kf, mf) = (fname(k), fname(m));
+    check_matrix_market_sizes([(&kk, &kf), (&mm, &mf)], dl.len(), &df)?;
+    let mut model = model_from_parts(name, ids, coords, &dl, kk, mm, &df)?;
+    model.sources = Sources {
+        k: kf,
+        m: mf,
+        dofs: df,
+        mesh: fname(nodes),
+    };
+    Ok(model)
+}
+
+/// Checks that K and M are square, of one size, and of the size of the DOF
+/// list (`n` equations from `dof_file`, or 3 per node of the node file),
+/// naming the file that disagrees with the other two.
+fn check_matrix_market_sizes(
+    [(k, kf), (m, mf)]: [(&SparseColMat<usize, f64>, &str); 2],
+    n: usize,
+    dof_file: &str,
+) -> Result<(), Error> {
+    for (a, f) in [(k, kf), (m, mf)] {
+        if a.nrows() != a.ncols() {
+            return Err(Error::parse(
+                f,
+                0,
+                format!("the matrix is {} × {}, not square", a.nrows(), a.ncols()),
+            ));
+        }
+    }
+    let (nk, nm) = (k.nrows(), m.nrows());
+    let msg = match (nk == n, nm == n) {
+        (true, true) => return Ok(()),
+        (true, false) => format!(
+            "{mf} is {nm} × {nm}, but {kf} is {n} × {n} and {dof_file} gives {n} equations: {mf} is from another model"
+        ),
+        (false, true) => format!(
+            "{kf} is {nk} × {nk}, but {mf} is {n} × {n} and {dof_file} gives {n} equations: {kf} is from another model"
+        ),
+        (false, false) if nk == nm => format!(
+            "{kf} and {mf} are {nk} × {nk}, but {dof_file} gives {n} equations: {dof_file} is from another model"
+        ),
+        (false, false) => format!(
+            "{kf} is {nk} × {nk}, {mf} is {nm} × {nm} and {dof_file} gives {n} equations: the three files come from \
+             different models"
+        ),
+    };
+    Err(Error::Mismatch(msg))
 }

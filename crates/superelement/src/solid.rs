@@ -9,7 +9,8 @@
 //! elements through a thin wall, has a consistent mass that is exact for rigid
 //! motions, and places mid-side nodes on curved boundaries.
 
-use crate::model::{DofMap, FeModel};
+use crate::geometry::SolidKind;
+use crate::model::{DofMap, FeModel, SolidElements};
 use crate::Error;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use flexmb_element::Material;
@@ -519,6 +520,17 @@ impl Mesh {
             m.as_ref(),
         )?;
         model.volume = Some(volume);
+        model.solid = Some(SolidElements {
+            kinds: vec![SolidKind::Hex20; self.elements.len()],
+            nodes: self.elements.iter().map(|e| e.to_vec()).collect(),
+            density: self
+                .element_material
+                .iter()
+                .map(|&m| Some(self.materials[m].rho))
+                .collect(),
+            density_source: "the materials of the built-in mesh".to_string(),
+            couplings: Vec::new(),
+        });
         Ok(model)
     }
 }

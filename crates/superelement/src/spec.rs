@@ -19,7 +19,7 @@
 //! ```
 
 use crate::builder::{build, BuildResult, BuildSettings};
-use crate::model::FeModel;
+use crate::model::{FeModel, ReferenceMass};
 use crate::readers::{
     read_calculix, read_matrix_market_model, write_file, write_matrix_market_dense,
 };
@@ -40,6 +40,10 @@ pub enum ModelSource {
         /// The mesh file, if not `JOB.inp`.
         #[serde(default)]
         inp: Option<String>,
+        /// A uniform density (kg/m³) for the rigid-body check of the mass
+        /// matrix against the mesh; replaces the deck's *DENSITY.
+        #[serde(default)]
+        density: Option<f64>,
     },
     /// Matrix Market K and M with a node file and an optional DOF file.
     MatrixMarket {
@@ -55,6 +59,10 @@ pub enum ModelSource {
         /// Mesh volume (m³) for the units check, if known.
         #[serde(default)]
         volume: Option<f64>,
+        /// A uniform density (kg/m³): M's rigid-body mass must then be
+        /// `volume` × `density` (needs `volume`).
+        #[serde(default)]
+        density: Option<f64>,
     },
 }
 
@@ -122,11 +130,17 @@ fn source_entry(path: &Path) -> Result<String, Error> {
 /// Loads the model a spec names.
 pub fn load_model(spec: &Spec, base_dir: &Path) -> Result<(FeModel, Vec<PathBuf>), Error> {
     Ok(match &spec.model {
-        ModelSource::CalculiX { job, inp } => {
+        ModelSource::CalculiX { job, inp, density } => {
             let job = base_dir.join(job);
             let inp = inp.as_ref().map(|p| base_dir.join(p));
             let (mut model, mesh) = read_calculix(&job, inp.as_deref())?;
             model.name = spec.name.clone();
+            if let Some(rho) = check_density(*density)? {
+                if let Some(solid) = &mut model.solid {
+                    solid.density = vec![Some(rho); solid.density.len()];
+                    solid.density_source = format!("the spec's density {rho} kg/m³");
+                }
+            }
             // the .inp and everything it *INCLUDEs
             let files = ["sti", "mas", "dof"]
                 .iter()
@@ -141,16 +155,39 @@ pub fn load_model(spec: &Spec, base_dir: &Path) -> Result<(FeModel, Vec<PathBuf>
             nodes,
             dofs,
             volume,
+            density,
         } => {
             let (k, m, nodes) = (base_dir.join(k), base_dir.join(m), base_dir.join(nodes));
             let dofs = dofs.as_ref().map(|d| base_dir.join(d));
             let mut model = read_matrix_market_model(&spec.name, &k, &m, &nodes, dofs.as_deref())?;
             model.volume = *volume;
+            if let Some(rho) = check_density(*density)? {
+                let v = volume.ok_or_else(|| {
+                    Error::Spec(format!(
+                        "model: MatrixMarket has density: Some({rho}) but no volume; the density is only used \
+                         with the volume (mass = volume × density)"
+                    ))
+                })?;
+                model.reference_mass = Some(ReferenceMass {
+                    mass: rho * v,
+                    what: format!("the spec's volume {v:e} m³ × density {rho} kg/m³"),
+                });
+            }
             let mut files = vec![k, m, nodes];
             files.extend(dofs);
             (model, files)
         }
     })
+}
+
+/// A spec's density, which must be positive and finite if given.
+fn check_density(density: Option<f64>) -> Result<Option<f64>, Error> {
+    match density {
+        Some(rho) if !(rho > 0.0 && rho.is_finite()) => Err(Error::Spec(format!(
+            "model: density = {rho}; a density must be positive and finite (kg/m³)"
+        ))),
+        d => Ok(d),
+    }
 }
 
 /// Writes superelement data as RON.
