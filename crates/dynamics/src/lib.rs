@@ -40,6 +40,7 @@ mod linearize;
 mod momentum;
 mod nodal_eom;
 mod outputs;
+mod reactions;
 mod simulate;
 mod skyline;
 mod statics;

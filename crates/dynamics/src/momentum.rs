@@ -44,42 +44,77 @@ impl Dynamics {
     /// As [`momentum`](Self::momentum) at the current kinematic state (after a
     /// solve with velocities).
     pub fn momentum_here(&self, about: [f64; 3]) -> Momentum {
-        let x = self.kin.x();
-        let mut p = vec![0.0; x.len()];
+        let mut p = vec![0.0; self.kin.x().len()];
         self.mass_times_add(self.kin.xd(), &mut p);
+        let (linear, angular) = self.resultant(&p, about, |_| true);
+        Momentum { linear, angular }
+    }
+
+    /// The resultant of a covariant nodal vector v (generalized momenta, or
+    /// nodal forces) over the nodes `keep` selects, at the current
+    /// configuration: its projections on a rigid translation, Σ v_r, and on a
+    /// rigid rotation about `about`, Σ (r − a) × v_r + ½ Σ Λ(λ) v_λ (planar:
+    /// plus v_φ). For forces these are the total force and the total moment.
+    /// Nodes that share their position (`position_of`, e.g. the two nodes of
+    /// a hinge) count it once: a rigid translation moves each position
+    /// coordinate once.
+    pub(crate) fn resultant(
+        &self,
+        v: &[f64],
+        about: [f64; 3],
+        keep: impl Fn(&flexmb_model::NodeInfo) -> bool,
+    ) -> ([f64; 3], [f64; 3]) {
+        let x = self.kin.x();
         let mut linear = [0.0; 3];
         let mut angular = [0.0; 3];
         let spatial = self.mech.dimension == Dimension::Spatial;
-        for node in &self.mech.nodes {
-            let pr: Vec<f64> = node.position.iter().map(|&i| p[i]).collect();
-            let r: Vec<f64> = node
-                .position
-                .iter()
-                .enumerate()
-                .map(|(k, &i)| x[i] - about[k])
-                .collect();
-            for k in 0..pr.len() {
-                linear[k] += pr[k];
+        let mut counted = vec![false; x.len()];
+        for node in self.mech.nodes.iter().filter(|n| keep(n)) {
+            let (mut force, moment) = node_resultant(x, v, node);
+            if node.position.iter().any(|&i| counted[i]) {
+                force = [0.0; 3];
+            }
+            let mut r = [0.0; 3];
+            for (k, &i) in node.position.iter().enumerate() {
+                counted[i] = true;
+                r[k] = x[i] - about[k];
+                linear[k] += force[k];
             }
             if spatial {
-                angular[0] += r[1] * pr[2] - r[2] * pr[1];
-                angular[1] += r[2] * pr[0] - r[0] * pr[2];
-                angular[2] += r[0] * pr[1] - r[1] * pr[0];
-            } else {
-                angular[2] += r[0] * pr[1] - r[1] * pr[0];
+                angular[0] += r[1] * force[2] - r[2] * force[1];
+                angular[1] += r[2] * force[0] - r[0] * force[2];
             }
-            match &node.orientation {
-                Some(o) if o.len() == 4 => {
-                    let l = EulerParameters([x[o[0]], x[o[1]], x[o[2]], x[o[3]]]);
-                    let lm = l.lambda();
-                    for (k, h) in angular.iter_mut().enumerate() {
-                        *h += 0.5 * (0..4).map(|j| lm[(k, j)] * p[o[j]]).sum::<f64>();
-                    }
-                }
-                Some(o) if o.len() == 1 => angular[2] += p[o[0]],
-                _ => {}
+            angular[2] += r[0] * force[1] - r[1] * force[0];
+            for k in 0..3 {
+                angular[k] += moment[k];
             }
         }
-        Momentum { linear, angular }
+        (linear, angular)
     }
+}
+
+/// The force (the position components of v) and the moment about the node
+/// itself (½ Λ(λ) v_λ, from δλ = ½ Λᵀ δθ of (2.14); planar: v_φ in z) of a
+/// covariant nodal vector v at one node.
+pub(crate) fn node_resultant(
+    x: &[f64],
+    v: &[f64],
+    node: &flexmb_model::NodeInfo,
+) -> ([f64; 3], [f64; 3]) {
+    let mut force = [0.0; 3];
+    for (k, &i) in node.position.iter().enumerate() {
+        force[k] = v[i];
+    }
+    let mut moment = [0.0; 3];
+    match &node.orientation {
+        Some(o) if o.len() == 4 => {
+            let lm = EulerParameters([x[o[0]], x[o[1]], x[o[2]], x[o[3]]]).lambda();
+            for (k, m) in moment.iter_mut().enumerate() {
+                *m = 0.5 * (0..4).map(|j| lm[(k, j)] * v[o[j]]).sum::<f64>();
+            }
+        }
+        Some(o) if o.len() == 1 => moment[2] = v[o[0]],
+        _ => {}
+    }
+    (force, moment)
 }

@@ -1,5 +1,6 @@
-//! The outputs a scene asks for (node positions and rotations, deformations,
-//! stress resultants, energies, DOFs), as named columns of a table.
+//! The outputs a scene asks for (node positions, rotations and their rates,
+//! deformations, stress resultants, energies, momentum, support reactions,
+//! DOFs), as named columns of a table.
 
 use crate::{Dynamics, DynamicsError};
 use flexmb_model::{Coordinate, OutputSpec};
@@ -15,6 +16,27 @@ enum Column {
     Gravitational,
     ExternalWork,
     Q(usize),
+    /// ẋ at a nodal coordinate.
+    Xd(usize),
+    /// Component k of ω = 2Λ(λ)λ̇ (global axes) of a node's Euler parameters.
+    Omega(usize, [usize; 4]),
+    /// Component k of the linear (k < 3) or angular (3 + k) momentum about a point.
+    Momentum(usize, [f64; 3]),
+    /// Component k of the force (k < 3) or moment (3 + k) of the supports on node i.
+    Reaction(usize, usize),
+}
+
+/// The components (index into `names`, name) of a planar (x, y and the
+/// z moment) or spatial (all six) force/moment or momentum pair.
+fn plane_or_space(
+    m: &flexmb_model::Mechanism,
+    names: [&'static str; 6],
+) -> Vec<(usize, &'static str)> {
+    let keep: &[usize] = match m.dimension {
+        flexmb_model::Dimension::Planar => &[0, 1, 5],
+        flexmb_model::Dimension::Spatial => &[0, 1, 2, 3, 4, 5],
+    };
+    keep.iter().map(|&k| (k, names[k])).collect()
 }
 
 /// A recorder of the requested outputs.
@@ -123,6 +145,60 @@ impl OutputTable {
                         header.push(format!("q:{}", m.coordinate_name(*c)));
                     }
                 }
+                OutputSpec::Velocity(id) => {
+                    let n = m.node(id).ok_or_else(|| unknown("node", id))?;
+                    for (k, i) in n.position.iter().enumerate() {
+                        columns.push(Column::Xd(*i));
+                        header.push(format!("{id}.v{}", ["x", "y", "z"][k]));
+                    }
+                }
+                OutputSpec::AngularVelocity(id) => {
+                    let n = m.node(id).ok_or_else(|| unknown("node", id))?;
+                    match n.orientation.as_deref() {
+                        Some([phi]) => {
+                            columns.push(Column::Xd(*phi));
+                            header.push(format!("{id}.omega_z"));
+                        }
+                        Some([a, b, c, d]) => {
+                            for k in 0..3 {
+                                columns.push(Column::Omega(k, [*a, *b, *c, *d]));
+                                header.push(format!("{id}.omega_{}", ["x", "y", "z"][k]));
+                            }
+                        }
+                        _ => {
+                            return Err(DynamicsError::Invalid(format!(
+                                "output: node '{id}' has no rotation"
+                            )))
+                        }
+                    }
+                }
+                OutputSpec::Momentum(point) => {
+                    let mut about = [0.0; 3];
+                    for (a, p) in about.iter_mut().zip(point) {
+                        *a = *p;
+                    }
+                    for (k, name) in plane_or_space(&m, ["L_x", "L_y", "L_z", "H_x", "H_y", "H_z"])
+                    {
+                        columns.push(Column::Momentum(k, about));
+                        header.push(name.to_string());
+                    }
+                }
+                OutputSpec::Reaction(id) => {
+                    let i = m
+                        .nodes
+                        .iter()
+                        .position(|n| n.id == *id)
+                        .ok_or_else(|| unknown("node", id))?;
+                    let has_moment = m.nodes[i].orientation.is_some();
+                    for (k, name) in plane_or_space(&m, ["R_x", "R_y", "R_z", "M_x", "M_y", "M_z"])
+                    {
+                        if k >= 3 && !has_moment {
+                            continue;
+                        }
+                        columns.push(Column::Reaction(k, i));
+                        header.push(format!("{id}.{name}"));
+                    }
+                }
             }
         }
         Ok(Self {
@@ -183,9 +259,35 @@ impl OutputTable {
         } else {
             0.0
         };
+        let reactions = if self
+            .columns
+            .iter()
+            .any(|c| matches!(c, Column::Reaction(..)))
+        {
+            let mut qdd = vec![0.0; q.len()];
+            dy.accelerations_by_projection(t, q, qd, &mut qdd)?;
+            let r = dy.nodal_reactions(t, q, qd, &qdd)?;
+            let nodes = self.columns.iter().filter_map(|c| match c {
+                Column::Reaction(_, i) => Some(*i),
+                _ => None,
+            });
+            nodes.map(|i| (i, dy.node_reaction(&r, i))).collect()
+        } else {
+            vec![]
+        };
         dy.kinematics_at(t, q, Some(qd))?;
+        let momenta: Vec<([f64; 3], crate::Momentum)> = self
+            .columns
+            .iter()
+            .filter_map(|c| match c {
+                Column::Momentum(_, a) => Some(*a),
+                _ => None,
+            })
+            .map(|a| (a, dy.momentum_here(a)))
+            .collect();
         dy.forces(t, true);
         let x = dy.kin.x();
+        let xd = dy.kin.xd();
         let eps = dy.kin.eps();
         Ok(self
             .columns
@@ -205,6 +307,25 @@ impl OutputTable {
                     Coordinate::Node(i) => x[i],
                     Coordinate::Def(j) => eps[j],
                 },
+                Column::Xd(i) => xd[*i],
+                Column::Omega(k, o) => {
+                    let l = EulerParameters([x[o[0]], x[o[1]], x[o[2]], x[o[3]]]);
+                    l.omega(&[xd[o[0]], xd[o[1]], xd[o[2]], xd[o[3]]])[*k]
+                }
+                Column::Momentum(k, a) => {
+                    let p = momenta.iter().find(|(b, _)| b == a).map(|(_, p)| p);
+                    p.map_or(f64::NAN, |p| {
+                        if *k < 3 {
+                            p.linear[*k]
+                        } else {
+                            p.angular[*k - 3]
+                        }
+                    })
+                }
+                Column::Reaction(k, i) => {
+                    let r = reactions.iter().find(|(j, _)| j == i).map(|(_, r)| r);
+                    r.map_or(f64::NAN, |(f, m)| if *k < 3 { f[*k] } else { m[*k - 3] })
+                }
             })
             .collect())
     }

@@ -98,24 +98,15 @@ impl Dynamics {
                 .add_deformation_forces(&unit, cols.col_as_slice_mut(c));
             unit[j] = 0.0;
         }
-        let a = faer::Mat::from_fn(unsupported.len(), constrained.len(), |i, c| {
-            cols[(unsupported[i], c)]
+        // A μ = −r over the unsupported coordinates, least squares; with more
+        // constraints than unsupported coordinates the system is padded with
+        // zero rows (μ is then not unique, its forces at the supports are)
+        let rows = unsupported.len().max(constrained.len());
+        let a = faer::Mat::from_fn(rows, constrained.len(), |i, c| {
+            unsupported.get(i).map_or(0.0, |&x| cols[(x, c)])
         });
-        let mut b = faer::Mat::from_fn(unsupported.len(), 1, |i, _| -r[unsupported[i]]);
-        if a.nrows() < a.ncols() {
-            // more constraints than unsupported coordinates: pad with zero
-            // rows so that the least-squares solve is defined
-            let pad = a.ncols() - a.nrows();
-            let a2 = faer::Mat::from_fn(a.ncols(), a.ncols(), |i, c| {
-                if i < a.nrows() { a[(i, c)] } else { 0.0 }
-            });
-            let mut b2 = faer::Mat::from_fn(a.ncols(), 1, |i, _| if i < b.nrows() { b[(i, 0)] } else { 0.0 });
-            let _ = pad;
-            a2.qr().solve_lstsq_in_place(b2.as_mut());
-            b = b2;
-        } else {
-            a.qr().solve_lstsq_in_place(b.as_mut());
-        }
+        let mut b = faer::Mat::from_fn(rows, 1, |i, _| unsupported.get(i).map_or(0.0, |&x| -r[x]));
+        a.qr().solve_lstsq_in_place(b.as_mut());
         for (c, _) in constrained.iter().enumerate() {
             let mu = b[(c, 0)];
             if mu.is_finite() && mu != 0.0 {
@@ -205,7 +196,10 @@ mod tests {
                 *v += 0.3 * ((k as f64) * 0.7).sin();
             }
             let worst = check_momentum_balance(&mut dy, t, &q0, &qd);
-            assert!(worst < 1e-6, "{name}: momentum balance off by {worst:e} of the forces");
+            assert!(
+                worst < 1e-6,
+                "{name}: momentum balance off by {worst:e} of the forces"
+            );
         }
     }
 
@@ -225,7 +219,12 @@ mod tests {
             .x_roles
             .iter()
             .zip(&r)
-            .filter(|(role, _)| !matches!(role, flexmb_model::XRole::Fixed | flexmb_model::XRole::Input(_)))
+            .filter(|(role, _)| {
+                !matches!(
+                    role,
+                    flexmb_model::XRole::Fixed | flexmb_model::XRole::Input(_)
+                )
+            })
             .fold(0.0f64, |m, (_, v)| m.max(v.abs()));
         let (force, moment) = dy.total_force(&r, [0.0; 3]);
         let rmax = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -233,8 +232,14 @@ mod tests {
         let f: Vec<f64> = dy.f.clone();
         let (load, load_moment) = dy.total_force(&f, [0.0; 3]);
         for k in 0..3 {
-            assert!((force[k] + load[k]).abs() < 1e-8 * rmax, "force {k}: {force:?} + {load:?}");
-            assert!((moment[k] + load_moment[k]).abs() < 1e-8 * rmax, "moment {k}");
+            assert!(
+                (force[k] + load[k]).abs() < 1e-8 * rmax,
+                "force {k}: {force:?} + {load:?}"
+            );
+            assert!(
+                (moment[k] + load_moment[k]).abs() < 1e-8 * rmax,
+                "moment {k}"
+            );
         }
         // the weight is carried: 1.368 kg body + flexures under 9.81 m/s²
         assert!(force[2] > 0.0);

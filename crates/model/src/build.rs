@@ -760,6 +760,7 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
     mech.check_outputs()?;
     check_reference_configuration(&mech, &part_axes)?;
     crate::roles::assign(scene, &mut mech)?;
+    mech.check_output_supports()?;
     crate::loads::assign(scene, &mut mech)?;
     Ok(mech)
 }

@@ -23,6 +23,10 @@ fn spelled(o: &OutputSpec) -> String {
         OutputSpec::Stress(e, d) => format!("Stress({e:?}, {d:?})"),
         OutputSpec::Energies => "Energies".into(),
         OutputSpec::Dofs => "Dofs".into(),
+        OutputSpec::Velocity(n) => format!("Velocity({n:?})"),
+        OutputSpec::AngularVelocity(n) => format!("AngularVelocity({n:?})"),
+        OutputSpec::Momentum(p) => format!("Momentum({p:?})"),
+        OutputSpec::Reaction(n) => format!("Reaction({n:?})"),
     }
 }
 
@@ -40,8 +44,8 @@ fn check_output(mech: &Mechanism, o: &OutputSpec) -> Result<(), ModelError> {
         })
     };
     match o {
-        OutputSpec::Position(id) => node(id).map(|_| ()),
-        OutputSpec::Rotation(id) => match node(id)?.orientation {
+        OutputSpec::Position(id) | OutputSpec::Velocity(id) => node(id).map(|_| ()),
+        OutputSpec::Rotation(id) | OutputSpec::AngularVelocity(id) => match node(id)?.orientation {
             Some(_) => Ok(()),
             None => Err(ModelError::invalid(
                 ctx,
@@ -68,8 +72,62 @@ fn check_output(mech: &Mechanism, o: &OutputSpec) -> Result<(), ModelError> {
             }
             Ok(())
         }
+        OutputSpec::Momentum(point) => {
+            let dim = match mech.dimension {
+                crate::Dimension::Planar => 2,
+                crate::Dimension::Spatial => 3,
+            };
+            if point.len() != dim || point.iter().any(|v| !v.is_finite()) {
+                return Err(ModelError::invalid(
+                    ctx,
+                    format!("the point about which the angular momentum is taken needs {dim} finite coordinates, got {point:?}"),
+                ));
+            }
+            Ok(())
+        }
+        OutputSpec::Reaction(id) => node(id).map(|_| ()),
         OutputSpec::Energies | OutputSpec::Dofs => Ok(()),
     }
+}
+
+/// Checks that a `Reaction` output's node has a support: a fixed or
+/// prescribed coordinate, and all or none of its rotation coordinates (needs
+/// the roles, so it runs after the DOF choice).
+fn check_support(mech: &Mechanism, o: &OutputSpec) -> Result<(), ModelError> {
+    let OutputSpec::Reaction(id) = o else {
+        return Ok(());
+    };
+    let ctx = format!("output {}", spelled(o));
+    let Some(n) = mech.node(id) else {
+        return Ok(());
+    };
+    let supported = |i: &usize| {
+        matches!(
+            mech.x_roles[*i],
+            crate::XRole::Fixed | crate::XRole::Input(_)
+        )
+    };
+    if !n
+        .position
+        .iter()
+        .chain(n.orientation.iter().flatten())
+        .any(supported)
+    {
+        return Err(ModelError::invalid(
+            ctx,
+            format!("node '{id}' has no fixed or prescribed coordinate, so no support acts on it"),
+        ));
+    }
+    if let Some(o) = &n.orientation {
+        let k = o.iter().filter(|i| supported(i)).count();
+        if k != 0 && k != o.len() {
+            return Err(ModelError::invalid(
+                ctx,
+                format!("node '{id}' has {k} of its {} rotation coordinates fixed or prescribed: its reaction moment is not defined", o.len()),
+            ));
+        }
+    }
+    Ok(())
 }
 
 impl Mechanism {
@@ -78,5 +136,11 @@ impl Mechanism {
     /// node has rotation coordinates. The error names the output.
     pub fn check_outputs(&self) -> Result<(), ModelError> {
         self.outputs.iter().try_for_each(|o| check_output(self, o))
+    }
+
+    /// Checks that every `Reaction` output's node is supported (after the
+    /// roles are assigned).
+    pub fn check_output_supports(&self) -> Result<(), ModelError> {
+        self.outputs.iter().try_for_each(|o| check_support(self, o))
     }
 }

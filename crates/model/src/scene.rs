@@ -319,6 +319,20 @@ pub enum OutputSpec {
     Energies,
     /// The degrees of freedom.
     Dofs,
+    /// Velocity of a node (the rates of its position coordinates).
+    Velocity(String),
+    /// Angular velocity of a node: planar φ̇; spatial ω = 2Λ(λ)λ̇ in global
+    /// axes (thesis (2.14)).
+    AngularVelocity(String),
+    /// Total linear momentum and angular momentum about a point (2 planar or
+    /// 3 spatial components), exact for every inertia element: the
+    /// projections of the generalized momenta on a rigid translation and
+    /// rotation.
+    Momentum(Vec<f64>),
+    /// The force (and moment, about the node) that the supports exert on a
+    /// node with fixed or prescribed coordinates, from the nodal equations of
+    /// motion with the stresses of rigid and prescribed deformations.
+    Reaction(String),
 }
 
 /// Initial velocity of a group of nodes moving as a rigid body.
