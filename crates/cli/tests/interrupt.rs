@@ -284,6 +284,47 @@ fn an_interrupted_sweep_stops_at_once_and_says_what_was_written() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// `flexmb reduce` has nothing partial to write (a model from part of its
+/// reference sweep would cover less than asked): SIGTERM during its sweep
+/// of 3000 configurations (seconds of work) exits at once with 143 and
+/// writes no model.
+#[test]
+fn an_interrupted_reduction_exits_at_once_without_a_model() {
+    let dir = temp_dir("reduce");
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("model.ron");
+    let scene = fixture("straight_guidance_spatial.ron");
+    let args = [
+        "reduce",
+        scene.to_str().unwrap(),
+        "--method",
+        "fbm-svd",
+        "--modes",
+        "3",
+        "--over",
+        "load",
+        "--from",
+        "-1",
+        "--to",
+        "1",
+        "--t-load",
+        "0.05",
+        "--n",
+        "3000",
+    ];
+    let mut child = start(&args, &model);
+    let _stdout = wait_until_computing(&mut child, Duration::from_millis(300));
+    send(&child, "TERM");
+    let (status, _, err) = wait_for_exit(&mut child, EXIT_WITHIN);
+    assert_eq!(status.code(), Some(143), "{err}");
+    assert!(
+        err.contains("interrupted by SIGTERM: nothing partial to write"),
+        "{err}"
+    );
+    assert!(!model.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `flexmb info SCENE | head -1` with the reader gone before anything is
 /// printed: every write to stdout fails with BrokenPipe. No panic (it used
 /// to be exit code 101, "failed printing to stdout"), exit code 0.
