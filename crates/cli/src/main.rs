@@ -1,10 +1,20 @@
 //! `flexmb`: flexible multibody mechanisms from the command line.
 //!
 //! Exit codes: 0 success, 1 a computation failed, 2 invalid input (scene,
-//! options), 130 interrupted (partial results are written).
+//! model, options out of range, an output location that cannot be written),
+//! 130 interrupted by SIGINT (Ctrl-C), 143 by SIGTERM: `simulate` and
+//! `sweep` write their partial results first, the other commands have none
+//! and exit at once; a second signal exits at once (see [`interrupt`]). A
+//! closed standard output (`flexmb info SCENE | head -1`) is no error: the
+//! rest of the printout is dropped and the exit code is unchanged (see
+//! [`out`]).
+#![deny(clippy::print_stdout, clippy::print_stderr)]
 
 mod coords;
 mod finite;
+mod interrupt;
+mod options;
+mod out;
 mod path;
 mod reduce;
 mod reduced;
@@ -16,13 +26,13 @@ use flexmb_dynamics::{
 };
 use flexmb_model::Scene;
 use flexmb_plot::write_csv;
+use out::{errln, say};
 use report::{
     count_bar, linspace, time_bar, write_frequency_sweep, write_outputs, FrequencySweep,
     OutputRows, Response,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 #[derive(Parser)]
@@ -50,11 +60,11 @@ enum Command {
         /// Scene file (RON).
         scene: PathBuf,
         /// Time at which loads and inputs are evaluated.
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
         time: f64,
         /// Number of equal load increments (each halved while its Newton
-        /// iteration fails).
-        #[arg(long, default_value_t = 1)]
+        /// iteration fails), at least 1.
+        #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
         steps: usize,
         /// Output directory.
         #[arg(long, default_value = "results/static")]
@@ -66,8 +76,8 @@ enum Command {
     Eig {
         /// Scene file (RON).
         scene: PathBuf,
-        /// Number of modes.
-        #[arg(long, default_value_t = 10)]
+        /// Number of modes, at least 1.
+        #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
         modes: usize,
         /// Linearize at the static equilibrium under the scene's loads and gravity.
         #[arg(long)]
@@ -94,21 +104,21 @@ enum Command {
 struct SimulateArgs {
     /// Scene file (RON).
     scene: PathBuf,
-    /// End time (s).
-    #[arg(long, default_value_t = 1.0)]
+    /// End time (s), positive.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     t_end: f64,
-    /// Number of output points.
-    #[arg(long, default_value_t = 501)]
+    /// Number of output points, at least 2 (t = 0 and --t-end).
+    #[arg(long, default_value_t = 501, allow_negative_numbers = true)]
     outputs: usize,
     /// dopri5 (ode45-like), adams (Shampine–Gordon) or genalpha (implicit;
     /// unreduced models only).
     #[arg(long, default_value = "dopri5")]
     integrator: String,
-    /// Relative tolerance (ode45 default 1e-3).
-    #[arg(long, default_value_t = 1e-3)]
+    /// Relative tolerance, positive (ode45 default 1e-3).
+    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
     rtol: f64,
-    /// Absolute tolerance (ode45 default 1e-6).
-    #[arg(long, default_value_t = 1e-6)]
+    /// Absolute tolerance, positive (ode45 default 1e-6).
+    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     atol: f64,
     /// Start from the static equilibrium at t = 0.
     #[arg(long)]
@@ -135,20 +145,20 @@ struct SweepArgs {
     #[arg(long)]
     over: String,
     /// First value of the sweep parameter.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     from: f64,
-    /// Last value.
-    #[arg(long, allow_negative_numbers = true)]
+    /// Last value (not --from).
+    #[arg(long, allow_hyphen_values = true)]
     to: f64,
-    /// Number of configurations.
-    #[arg(long, default_value_t = 50)]
+    /// Number of configurations, at least 2 (--from and --to).
+    #[arg(long, default_value_t = 50, allow_negative_numbers = true)]
     n: usize,
-    /// Modes per configuration.
-    #[arg(long, default_value_t = 6)]
+    /// Modes per configuration, at least 1.
+    #[arg(long, default_value_t = 6, allow_negative_numbers = true)]
     modes: usize,
     /// Time at which the scene's loads are evaluated (a load sweep scales
     /// them: pick a time where they act, e.g. the peak of a pulse).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     t_load: f64,
     /// With `--over path`: a CSV file `s,NAME,...` giving each coordinate's
     /// change from the reference configuration as a function of s (linear
@@ -171,8 +181,9 @@ enum Failure {
     Input(String),
     /// A computation failed (exit code 1).
     Compute(String),
-    /// Stopped by Ctrl-C after writing partial results (exit code 130).
-    Interrupted,
+    /// Stopped by SIGINT or SIGTERM (exit code 130 or 143); says what was
+    /// written.
+    Interrupted(String),
 }
 
 /// Reads a scene and builds its mechanism.
@@ -191,12 +202,18 @@ fn io_err(e: std::io::Error, what: &Path) -> Failure {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    if let Err(e) = interrupt::install() {
+        errln(&format!(
+            "warning: cannot handle SIGINT and SIGTERM ({e}): a signal ends the run without partial results"
+        ));
     }
-    let result = match cli.command {
+    let result = run(cli.command);
+    exit_code(result)
+}
+
+/// Runs a command.
+fn run(command: Command) -> Result<(), Failure> {
+    match command {
         Command::Info { scene } => info(&scene),
         Command::Static {
             scene,
@@ -204,7 +221,7 @@ fn main() -> ExitCode {
             steps,
             out,
         } => statics(&scene, time, steps, &out),
-        Command::Simulate(a) => simulate(&a, &interrupted),
+        Command::Simulate(a) => simulate(&a),
         Command::Eig {
             scene,
             modes,
@@ -214,42 +231,53 @@ fn main() -> ExitCode {
         Command::Sweep(a) => sweep(&a),
         Command::Reduce(a) => reduce::reduce(&a),
         Command::BuildSuperelement { spec } => build_superelement(&spec),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::Input(m)) => {
-            eprintln!("error: {m}");
-            ExitCode::from(2)
-        }
-        Err(Failure::Compute(m)) => {
-            eprintln!("error: {m}");
-            ExitCode::from(1)
-        }
-        Err(Failure::Interrupted) => {
-            eprintln!("interrupted: partial results written");
-            ExitCode::from(130)
-        }
     }
 }
 
+/// Reports the outcome of a command on stderr and gives its exit code (see
+/// the crate documentation). A signal that came while complete results were
+/// written still gives its own code.
+fn exit_code(result: Result<(), Failure>) -> ExitCode {
+    let (code, message) = match result {
+        Ok(()) => match interrupt::exit_code() {
+            Some(c) => (c, interrupt::report("the results are complete")),
+            None => return ExitCode::SUCCESS,
+        },
+        Err(Failure::Input(m)) => (2, format!("error: {m}")),
+        Err(Failure::Compute(m)) => (1, format!("error: {m}")),
+        Err(Failure::Interrupted(what)) => (
+            interrupt::exit_code().unwrap_or(130),
+            interrupt::report(&what),
+        ),
+    };
+    errln(&message);
+    ExitCode::from(code)
+}
+
+/// `flexmb info`: the mechanism's summary, degrees of freedom and inputs.
 fn info(path: &Path) -> Result<(), Failure> {
     let (_, mech) = load(path)?;
-    println!("{}", mech.summary());
-    println!("degrees of freedom:");
+    say!("{}", mech.summary());
+    say!("degrees of freedom:");
     for (k, c) in mech.dofs.iter().enumerate() {
-        println!("  q{k:<3} {}", mech.coordinate_name(*c));
+        say!("  q{k:<3} {}", mech.coordinate_name(*c));
     }
     if !mech.inputs.is_empty() {
-        println!("prescribed inputs:");
+        say!("prescribed inputs:");
         for i in &mech.inputs {
-            println!("  {}", mech.coordinate_name(i.target));
+            say!("  {}", mech.coordinate_name(i.target));
         }
     }
     Ok(())
 }
 
+/// `flexmb static`: the equilibrium at time `t` in `steps` load increments,
+/// written to `out`.
 fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure> {
+    options::finite("--time", t)?;
+    options::at_least("--steps", steps, 1, "the number of load increments")?;
     let (_, mech) = load(path)?;
+    options::writable_dir("--out", out)?;
     let mut dy = Dynamics::new(mech.clone());
     let opts = StaticOptions {
         load_steps: steps,
@@ -264,10 +292,11 @@ fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure>
     let what = "static equilibrium";
     finite::check(what, sol.x.iter().copied(), |i| mech.x_names[i].clone())?;
     finite::check(what, sol.eps.iter().copied(), |j| mech.eps_names[j].clone())?;
-    println!("{}", mech.summary());
-    println!(
+    say!("{}", mech.summary());
+    say!(
         "equilibrium found in {} Newton iterations, {} load increments",
-        sol.iterations, sol.increments
+        sol.iterations,
+        sol.increments
     );
     std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
     let mut rows = vec![];
@@ -278,7 +307,7 @@ fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure>
             .zip(&n.at)
             .map(|(i, a)| format!("{:+.6e}", sol.x[*i] - a))
             .collect();
-        println!("  {:<14} displacement [{}]", n.id, d.join(", "));
+        say!("  {:<14} displacement [{}]", n.id, d.join(", "));
         rows.push(n.position.iter().map(|i| sol.x[*i]).collect::<Vec<f64>>());
     }
     let dim = mech.nodes.first().map_or(3, |n| n.position.len());
@@ -308,43 +337,40 @@ fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure>
         &eps,
     )
     .map_err(|e| io_err(e, &p))?;
-    println!("wrote {}", out.display());
+    say!("wrote {}", out.display());
     Ok(())
 }
 
 /// `flexmb simulate`: the scene's time response, unreduced or with a reduced
 /// model, written by [`write_outputs`].
-fn simulate(a: &SimulateArgs, interrupted: &Arc<AtomicBool>) -> Result<(), Failure> {
+fn simulate(a: &SimulateArgs) -> Result<(), Failure> {
     let integrator: Integrator = a.integrator.parse().map_err(Failure::Input)?;
-    if !(a.t_end > 0.0 && a.t_end.is_finite()) {
-        return Err(Failure::Input(format!(
-            "--t-end must be positive, got {}",
-            a.t_end
-        )));
-    }
-    if !(a.rtol > 0.0 && a.atol > 0.0) {
-        return Err(Failure::Input("--rtol and --atol must be positive".into()));
-    }
+    options::positive("--t-end", a.t_end)?;
+    options::at_least(
+        "--outputs",
+        a.outputs,
+        2,
+        "the output points include t = 0 and --t-end",
+    )?;
+    options::positive("--rtol", a.rtol)?;
+    options::positive("--atol", a.atol)?;
     let (_, mech) = load(&a.scene)?;
+    options::writable_dir("--out", &a.out)?;
     let mut opts = SimulationOptions::new(integrator, 0.0, a.t_end, a.outputs);
     opts.rtol = a.rtol;
     opts.atol = a.atol;
+    opts.stop = Some(interrupt::stop_flag());
     let pb = time_bar();
-    let flag = interrupted.clone();
     let t_end = a.t_end;
     let observer = |t: f64| {
         pb.set_position((1000.0 * t / t_end) as u64);
         pb.set_message(format!("{t:.4}"));
-        if flag.load(Ordering::SeqCst) {
-            Control::Stop
-        } else {
-            Control::Continue
-        }
+        Control::Continue
     };
     let mut dy = Dynamics::new(mech.clone());
     let result = match &a.reduced {
         None => {
-            println!("{}", mech.summary());
+            say!("{}", mech.summary());
             simulate_unreduced(&mut dy, &opts, a.static_first, observer)
                 .map(|(r, rows)| (r, None, Some(rows)))
         }
@@ -353,7 +379,7 @@ fn simulate(a: &SimulateArgs, interrupted: &Arc<AtomicBool>) -> Result<(), Failu
     };
     pb.finish_and_clear();
     let (response, model, rows) = result?;
-    println!("{}", report::summary(&response));
+    say!("{}", report::summary(&response));
     let mut comments = vec![format!("flexmb simulate {}", a.scene.display())];
     if let (Some(m), Some(d)) = (&a.reduced, &model) {
         comments.push(format!("reduced model {}: {d}", m.display()));
@@ -362,11 +388,32 @@ fn simulate(a: &SimulateArgs, interrupted: &Arc<AtomicBool>) -> Result<(), Failu
         "integrator {integrator:?}, rtol {:e}, atol {:e}, {} function evaluations",
         a.rtol, a.atol, response.stats.rhs_evals
     ));
-    write_outputs(&mut dy, &response, rows, &comments, &a.out)?;
-    if response.stopped {
-        return Err(Failure::Interrupted);
+    let partial = response.stopped.then(|| stopped_run(&response, &opts));
+    if let Some(p) = &partial {
+        comments.push(format!("interrupted: {p}"));
     }
-    Ok(())
+    write_outputs(&mut dy, &response, rows, &comments, &a.out)?;
+    match partial {
+        Some(p) => Err(Failure::Interrupted(format!(
+            "partial results written: {p}"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// What a stopped run has: the output times reached, and the row at the
+/// step where it stopped.
+fn stopped_run(r: &Response, opts: &SimulationOptions) -> String {
+    let last = r.t.last().copied().unwrap_or(0.0);
+    let reached = opts.output_times.iter().filter(|t| **t <= last).count();
+    let n = opts.output_times.len();
+    if opts.output_times.contains(&last) {
+        format!("{reached} of {n} output times, to t = {last:.6} s")
+    } else {
+        format!(
+            "{reached} of {n} output times, then the state where the run stopped, t = {last:.6} s"
+        )
+    }
 }
 
 /// Integrates all degrees of freedom from the reference configuration (or
@@ -392,6 +439,7 @@ fn simulate_unreduced(
     let table = OutputTable::new(dy).map_err(|e| Failure::Input(e.to_string()))?;
     let mut rows = vec![];
     let mut failure = None;
+    let phase = interrupt::stoppable();
     let traj = dy
         .simulate_with(0.0, &q0, &qd0, opts, |p| {
             let x = p.dynamics.kinematics().x().to_vec();
@@ -408,15 +456,21 @@ fn simulate_unreduced(
                 }
             }
         })
-        .map_err(|e| Failure::Compute(e.to_string()))?;
+        .map_err(|e| Failure::Compute(e.to_string()));
+    phase.finish();
+    let traj = traj?;
     if let Some(e) = failure {
         return Err(Failure::Compute(e.to_string()));
     }
     Ok((traj, rows))
 }
 
+/// `flexmb eig`: the first `k` eigenfrequencies at the reference
+/// configuration or the static equilibrium, damped modes and buckling.
 fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), Failure> {
+    options::at_least("--modes", k, 1, "the number of modes")?;
     let (_, mech) = load(path)?;
+    options::at_most_dofs("--modes", k, &mech)?;
     let mut dy = Dynamics::new(mech.clone());
     let mut q = mech.q0();
     if static_first {
@@ -439,10 +493,10 @@ fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), 
     finite::check(&format!("eig{at}"), frequencies.iter().copied(), |i| {
         format!("the undamped eigenfrequency of mode {}", i + 1)
     })?;
-    println!("{}", mech.summary());
-    println!("undamped eigenfrequencies (Hz){at}:");
+    say!("{}", mech.summary());
+    say!("undamped eigenfrequencies (Hz){at}:");
     for (i, f) in frequencies.iter().enumerate() {
-        println!("  {:>3}  {f:>14.6}", i + 1);
+        say!("  {:>3}  {f:>14.6}", i + 1);
     }
     let has_damping = lin.d.col_iter().any(|c| c.iter().any(|v| *v != 0.0));
     if has_damping {
@@ -456,9 +510,9 @@ fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), 
             let what = ["frequency", "damping ratio"][i % 2];
             format!("the {what} of damped mode {}", i / 2 + 1)
         })?;
-        println!("damped modes (frequency Hz, damping ratio):");
+        say!("damped modes (frequency Hz, damping ratio):");
         for (i, m) in d.iter().take(k).enumerate() {
-            println!(
+            say!(
                 "  {:>3}  {:>14.6}  {:>8.4}",
                 i + 1,
                 m.frequency_hz,
@@ -472,9 +526,9 @@ fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), 
                 finite::check(&format!("eig{at}"), mu.iter().copied(), |i| {
                     format!("buckling load factor {}", i + 1)
                 })?;
-                println!("buckling load factors: {mu:?}")
+                say!("buckling load factors: {mu:?}")
             }
-            Err(e) => println!("buckling: {e}"),
+            Err(e) => say!("buckling: {e}"),
         }
     }
     Ok(())
@@ -484,11 +538,7 @@ fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), 
 /// or a held coordinate (unreduced), or along a load scale (reduced model).
 fn sweep(a: &SweepArgs) -> Result<(), Failure> {
     let (over, n, k) = (a.over.as_str(), a.n, a.modes);
-    if n < 1 || !a.from.is_finite() || !a.to.is_finite() || !a.t_load.is_finite() {
-        return Err(Failure::Input(
-            "--n must be ≥ 1 and --from/--to/--t-load finite".into(),
-        ));
-    }
+    check_sweep_options(a)?;
     let values = linspace(a.from, a.to, n);
     if let Some(model) = &a.reduced {
         return reduced::sweep(a, model, &values);
@@ -548,7 +598,9 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         };
         (mech, param)
     };
-    println!("{}", mech.summary());
+    options::at_most_dofs("--modes", k, &mech)?;
+    options::writable_dir("--out", &a.out)?;
+    say!("{}", mech.summary());
     let pb = count_bar(2 * n as u64, "equilibria, then eigen analyses");
     let start = std::time::Instant::now();
     let opts = flexmb_linearize::SweepOptions {
@@ -557,11 +609,29 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         t: a.t_load,
         keep_vectors: false,
     };
-    let pts = flexmb_linearize::sweep(&mech, &param, &opts, &|d, _| pb.set_position(d as u64))
-        .map_err(|e| Failure::Compute(e.to_string()))?;
+    let phase = interrupt::stoppable();
+    let outcome = flexmb_linearize::sweep_until(
+        &mech,
+        &param,
+        &opts,
+        &|d, _| pb.set_position(d as u64),
+        Some(&interrupt::stop_flag()),
+    );
+    phase.finish();
     pb.finish_and_clear();
+    let outcome = outcome.map_err(|e| Failure::Compute(e.to_string()))?;
+    if outcome.stopped && outcome.points.is_empty() {
+        return Err(Failure::Interrupted(format!(
+            "nothing written: stopped while finding the equilibria ({} of {n} found), before any eigen analysis",
+            outcome.equilibria
+        )));
+    }
+    let pts = outcome.points;
     let wall = start.elapsed().as_secs_f64();
-    println!("{n} configurations, {k} modes each, in {wall:.2} s");
+    say!(
+        "{} configurations, {k} modes each, in {wall:.2} s",
+        pts.len()
+    );
     let sw = FrequencySweep {
         title: &mech.name,
         parameter: sweep_parameter_name(over),
@@ -569,11 +639,37 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         frequencies: pts.iter().map(|p| p.frequencies_hz.clone()).collect(),
         modes: k,
     };
-    let comments = [
+    let mut comments = vec![
         sweep_command_line(a),
         "undamped eigenfrequencies at static equilibria (rest linearization, thesis (E.6))".into(),
     ];
-    write_frequency_sweep(&sw, &comments, &a.out)
+    let done = sw.s.len();
+    if outcome.stopped {
+        comments.push(format!("interrupted: {done} of {n} configurations"));
+    }
+    write_frequency_sweep(&sw, &comments, &a.out)?;
+    if outcome.stopped {
+        return Err(Failure::Interrupted(format!(
+            "partial results written: {done} of {n} configurations"
+        )));
+    }
+    Ok(())
+}
+
+/// The ranges of `flexmb sweep`'s options, unreduced or reduced, and its
+/// output directory.
+fn check_sweep_options(a: &SweepArgs) -> Result<(), Failure> {
+    options::at_least(
+        "--n",
+        a.n,
+        2,
+        "the number of configurations, from --from to --to",
+    )?;
+    options::at_least("--modes", a.modes, 1, "the modes per configuration")?;
+    options::finite("--from", a.from)?;
+    options::finite("--to", a.to)?;
+    options::finite("--t-load", a.t_load)?;
+    options::distinct_ends(a.from, a.to)
 }
 
 /// The CSV column of a sweep parameter: `load_scale` or `NAME change`.
@@ -620,9 +716,9 @@ fn build_superelement(spec_path: &Path) -> Result<(), Failure> {
             Failure::Compute(e.to_string())
         }
     })?;
-    println!("{:#?}", out.result.report);
+    say!("{:#?}", out.result.report);
     for f in &out.written {
-        println!("wrote {}", f.display());
+        say!("wrote {}", f.display());
     }
     Ok(())
 }

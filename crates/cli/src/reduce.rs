@@ -5,6 +5,7 @@
 //! Next to the model it writes the reduced eigenfrequencies at the reference
 //! configuration and, for the SVD methods, the singular values.
 
+use crate::out::say;
 use crate::report::{count_bar, linspace};
 use crate::{coords, finite, io_err, Failure};
 use clap::ValueEnum;
@@ -77,7 +78,7 @@ pub(crate) struct ReduceArgs {
     /// modal: the first R modes; svd-modal: the first R modes of each
     /// configuration; fbm-svd: modes 1..R, each SVD'd; ibm-*: R interpolated
     /// modes, i.e. modes 2..R+1 (mode 1 is the motion along s).
-    #[arg(long, value_name = "R")]
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
     modes: usize,
     /// modal only: degrees of freedom kept as reduced coordinates (the large
     /// coordinates of (5.20)–(5.21)), comma-separated, named as `flexmb info`
@@ -85,15 +86,15 @@ pub(crate) struct ReduceArgs {
     #[arg(long, value_delimiter = ',', value_name = "COORD,...")]
     keep: Vec<String>,
     /// svd-modal only: the weight exponent a of ω^−a (5.22) [default: 0].
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     a: Option<f64>,
     /// svd-modal and fbm-svd: keep the singular vectors whose singular value
     /// exceeds this fraction of the sum [default: 0.01, the thesis's 1 %].
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     threshold: Option<f64>,
     /// fbm-svd only: the rule of the last SVD (step 9 of §6.3.2) [default:
     /// 0.005; why: `FINAL_SVD_THRESHOLD` in flexmb-reduction, docs/cli.md].
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     final_threshold: Option<f64>,
     /// The sweep of reference configurations: `load` (the scene's loads
     /// scaled; svd-modal, fbm-svd) or a degree of freedom held along the
@@ -102,18 +103,18 @@ pub(crate) struct ReduceArgs {
     over: Option<String>,
     /// First value of the sweep: a load scale, or the change of the held
     /// degree of freedom from its reference value.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     from: Option<f64>,
     /// Last value of the sweep.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     to: Option<f64>,
     /// Number of reference configurations [default: svd-modal 10 (thesis
     /// §5.4.1); fbm-svd, ibm-* 300 (thesis §6.4)].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     n: Option<usize>,
     /// Time at which the scene's loads (and inputs) are evaluated while the
     /// basis is built; a load sweep needs a time where the loads act.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     t_load: f64,
     /// Build the basis without the scene's gravity (as the thesis does,
     /// §6.4.1); the saved model is used with the scene's gravity.
@@ -220,8 +221,13 @@ fn check_options(a: &ReduceArgs) -> Result<(), Failure> {
             if n < 3 {
                 return input("--n: an interpolated basis needs at least 3 configurations".into());
             }
-        } else if n < 1 {
-            return input("--n must be at least 1".into());
+        } else {
+            crate::options::at_least(
+                "--n",
+                n,
+                2,
+                "the number of reference configurations, from --from to --to",
+            )?;
         }
     }
     Ok(())
@@ -296,7 +302,7 @@ fn reference_sweep(
              configurations (--n)"
         ))
     })?;
-    println!(
+    say!(
         "reference sweep: {what}, {modes} modes each, in {:.2} s",
         start.elapsed().as_secs_f64()
     );
@@ -458,14 +464,14 @@ fn report_singular_values(sv: &[SingularValues], model: &Path) -> Result<Vec<Pat
             format!("relative singular value {} of {}", i + 1, s.label)
         })?;
     }
-    println!("relative singular values (fraction of their sum):");
+    say!("relative singular values (fraction of their sum):");
     for s in sv {
         let discarded = s
             .relative
             .get(s.kept)
             .map(|x| format!("; largest discarded {x:.4}"))
             .unwrap_or_default();
-        println!(
+        say!(
             "  {:<8} kept {} of {}: {}{discarded}",
             s.label,
             s.kept,
@@ -529,10 +535,11 @@ fn report_singular_values(sv: &[SingularValues], model: &Path) -> Result<Vec<Pat
 pub(crate) fn reduce(a: &ReduceArgs) -> Result<(), Failure> {
     check_options(a)?;
     let (scene, mech) = crate::load(&a.scene)?;
-    println!("{}", mech.summary());
+    crate::options::writable_file("--out", &a.out)?;
+    say!("{}", mech.summary());
     let basis_mech = if a.no_gravity {
         if scene.gravity.is_none() {
-            println!("the scene has no gravity: --no-gravity changes nothing");
+            say!("the scene has no gravity: --no-gravity changes nothing");
         }
         let mut s = scene.clone();
         s.gravity = None;
@@ -543,15 +550,20 @@ pub(crate) fn reduce(a: &ReduceArgs) -> Result<(), Failure> {
     } else {
         mech.clone()
     };
-    // the sweep methods need this many modes per configuration
+    // the modes each configuration (or the reference, for modal) needs
     let needed = match a.method {
-        Method::Modal => 0,
+        Method::Modal => a.modes + a.keep.len(),
         Method::IbmMsi | Method::IbmMac => a.modes + 1,
         _ => a.modes,
     };
     if needed > mech.n_dof() {
+        let what = match a.method {
+            Method::Modal if a.keep.is_empty() => format!("{needed} modes"),
+            Method::Modal => format!("{needed} reduced coordinates with --keep"),
+            _ => format!("{needed} modes per configuration"),
+        };
         return Err(Failure::Input(format!(
-            "--modes {} needs {needed} modes per configuration but the scene has {} degrees of freedom",
+            "--modes {} needs {what} but the scene has {} degrees of freedom",
             a.modes,
             mech.n_dof()
         )));
@@ -569,7 +581,7 @@ pub(crate) fn reduce(a: &ReduceArgs) -> Result<(), Failure> {
         .into_model(mech.clone())
         .map_err(|e| Failure::Compute(e.to_string()))?;
     let nz = red.n_z();
-    println!(
+    say!(
         "reduced model: {nz} coordinates (from {}): {}",
         mech.n_dof(),
         built.saved.description
@@ -585,7 +597,7 @@ pub(crate) fn reduce(a: &ReduceArgs) -> Result<(), Failure> {
     let full = undamped_modes(&lin, nz)
         .map_err(|e| Failure::Compute(e.to_string()))?
         .frequencies_hz();
-    println!(
+    say!(
         "eigenfrequencies (Hz) at the reference, t = 0 (unreduced: as `flexmb eig`{}):",
         if matches!(built.saved.basis, SavedBasis::Interpolated { .. }) {
             "; the reduced model at its knot nearest to the reference"
@@ -599,11 +611,11 @@ pub(crate) fn reduce(a: &ReduceArgs) -> Result<(), Failure> {
     finite::check("reduce", full.iter().copied(), |i| {
         format!("the unreduced eigenfrequency of mode {}", i + 1)
     })?;
-    println!("  mode        reduced       unreduced  difference");
+    say!("  mode        reduced       unreduced  difference");
     let mut rows = vec![];
     for (i, f) in reduced.iter().enumerate() {
         let u = full.get(i).copied().unwrap_or(f64::NAN);
-        println!(
+        say!(
             "  {:>4} {f:>14.6}  {u:>14.6}  {:>+9.2e}",
             i + 1,
             (f - u) / u
@@ -627,6 +639,6 @@ pub(crate) fn reduce(a: &ReduceArgs) -> Result<(), Failure> {
         .save(&a.out)
         .map_err(|e| Failure::Compute(e.to_string()))?;
     let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
-    println!("wrote {}", names.join(", "));
+    say!("wrote {}", names.join(", "));
     Ok(())
 }

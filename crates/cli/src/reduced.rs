@@ -2,6 +2,7 @@
 //! saved by `flexmb reduce`, applied to a scene with the same degrees of
 //! freedom.
 
+use crate::out::say;
 use crate::report::{count_bar, write_frequency_sweep, FrequencySweep, Response};
 use crate::{Failure, SweepArgs};
 use flexmb_dynamics::{Control, Integrator, SimulationOptions};
@@ -17,8 +18,8 @@ fn load_model(mech: &Arc<Mechanism>, path: &Path) -> Result<(SavedModel, Reduced
     let red = saved
         .into_model(mech.clone())
         .map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?;
-    println!("{}", mech.summary());
-    println!(
+    say!("{}", mech.summary());
+    say!(
         "reduced model {}: {} coordinates (from {}); {}",
         path.display(),
         red.n_z(),
@@ -62,7 +63,7 @@ pub(crate) fn simulate(
     };
     red.set_load_scale(1.0);
     if matches!(saved.basis, SavedBasis::Interpolated { .. }) {
-        println!(
+        say!(
             "initial s = {:.6e} ({})",
             z0[0],
             if static_first {
@@ -81,9 +82,10 @@ pub(crate) fn simulate(
         .initial_qd(0.0, &q0)
         .map_err(|e| Failure::Compute(e.to_string()))?;
     let zd0 = red.project_velocities(0.0, &z0, &qd0).map_err(compute)?;
-    let traj = red
-        .simulate(0.0, &z0, &zd0, opts, |t, _, _| observer(t))
-        .map_err(compute)?;
+    let phase = crate::interrupt::stoppable();
+    let traj = red.simulate(0.0, &z0, &zd0, opts, |t, _, _| observer(t));
+    phase.finish();
+    let traj = traj.map_err(compute)?;
     let (q, qd) = traj
         .z
         .iter()
@@ -118,10 +120,11 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
     }
     let (_, mech) = crate::load(&a.scene)?;
     let (_, mut red) = load_model(&mech, model)?;
+    crate::options::writable_dir("--out", &a.out)?;
     let n = values.len();
     let k = a.modes.min(red.n_z());
     if k < a.modes {
-        println!(
+        say!(
             "the reduced model has {} coordinates: {k} eigenfrequencies per configuration",
             red.n_z()
         );
@@ -133,7 +136,12 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
             .equilibria_over_load_scale(a.t_load, values, &mut |d| pb.set_position(d as u64))
             .map_err(|e| Failure::Compute(format!("reduced sweep: {e}")))?;
         let mut freqs = Vec::with_capacity(n);
+        // the equilibria have no partial result; the frequencies do
+        let _phase = crate::interrupt::stoppable();
         for (i, (l, eq)) in values.iter().zip(&zs).enumerate() {
+            if crate::interrupt::requested() {
+                break;
+            }
             red.set_load_scale(*l);
             // the position solve starts at this equilibrium's configuration
             red.dynamics_mut().kinematics_mut().set_guess(&eq.x);
@@ -147,20 +155,35 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
     })();
     pb.finish_and_clear();
     let freqs = result?;
-    println!(
-        "{n} configurations, {k} modes each, in {:.2} s",
+    let done = freqs.len();
+    if done == 0 {
+        return Err(Failure::Interrupted(
+            "nothing written: stopped before the first eigen analysis".into(),
+        ));
+    }
+    say!(
+        "{done} configurations, {k} modes each, in {:.2} s",
         start.elapsed().as_secs_f64()
     );
     let sw = FrequencySweep {
         title: &mech.name,
         parameter: "load_scale".into(),
-        s: values.to_vec(),
+        s: values[..done].to_vec(),
         frequencies: freqs,
         modes: k,
     };
-    let comments = [
+    let mut comments = vec![
         crate::sweep_command_line(a),
         "undamped eigenfrequencies of the reduced model at its static equilibria (rest linearization (F.7)), continuation from load scale 0".into(),
     ];
-    write_frequency_sweep(&sw, &comments, &a.out)
+    if done < n {
+        comments.push(format!("interrupted: {done} of {n} configurations"));
+    }
+    write_frequency_sweep(&sw, &comments, &a.out)?;
+    if done < n {
+        return Err(Failure::Interrupted(format!(
+            "partial results written: {done} of {n} configurations"
+        )));
+    }
+    Ok(())
 }

@@ -2,6 +2,7 @@
 //! response table (`outputs.csv`/`.svg`, node paths), the eigenfrequency
 //! sweep (`eigenfrequencies.csv`/`.svg`) and progress bars.
 
+use crate::out::say;
 use crate::{finite, io_err, Failure};
 use flexmb_dynamics::{Dynamics, OutputTable};
 use flexmb_plot::{write_csv, Plot, Series};
@@ -113,7 +114,7 @@ pub(crate) fn write_outputs(
     }
     let svg = out.join("outputs.svg");
     plot.save(&svg).map_err(|e| io_err(e, &svg))?;
-    println!("wrote {} and {}", csv.display(), svg.display());
+    say!("wrote {} and {}", csv.display(), svg.display());
     // the path of every node whose position is an output (e.g. a manipulator tip)
     for (k, h) in table.header.iter().enumerate() {
         if let Some(node) = h.strip_suffix(".x") {
@@ -124,7 +125,7 @@ pub(crate) fn write_outputs(
                     .series(Series::line(node, &x, &y));
                 let f = out.join(format!("path_{node}.svg"));
                 p.save(&f).map_err(|e| io_err(e, &f))?;
-                println!("wrote {}", f.display());
+                say!("wrote {}", f.display());
             }
         }
     }
@@ -188,6 +189,6 @@ pub(crate) fn write_frequency_sweep(
     }
     let svg = out.join("eigenfrequencies.svg");
     plot.save(&svg).map_err(|e| io_err(e, &svg))?;
-    println!("wrote {} and {}", csv.display(), svg.display());
+    say!("wrote {} and {}", csv.display(), svg.display());
     Ok(())
 }

@@ -1,49 +1,379 @@
-//! Ctrl-C during `flexmb simulate`: the run stops at the next output, writes
-//! the partial results and exits with 130.
+//! Signals and closed pipes (issue 14, item 3): SIGINT and SIGTERM stop a
+//! long `simulate` or `sweep` between steps, the partial results are written
+//! and the exit code is 130 or 143; a second signal exits at once; a closed
+//! standard output is no panic.
 
-use std::process::{Command, Stdio};
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
-#[test]
-fn sigint_stops_a_simulation_with_partial_results_and_exit_130() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let out = std::env::temp_dir().join(format!("flexmb-interrupt-{}", std::process::id()));
+/// The wall time from sending a signal to the exit that we accept: the
+/// check itself is per integrator step (about 1 ms here, reported by the
+/// process, see [`reported_stop_ms`]); the rest is writing the partial
+/// results and process teardown on a loaded machine.
+const EXIT_WITHIN: Duration = Duration::from_secs(1);
+
+/// What the issue asks: the computation stops within 0.2 s of the signal.
+const STOP_WITHIN_MS: f64 = 200.0;
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes")
+        .join(name)
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("flexmb-interrupt-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// Starts `flexmb args...` with stdout and stderr piped.
+fn start(args: &[&str], out: &Path) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_flexmb"))
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits until the child has printed the scene's summary (the first line:
+/// the mechanism is built, the computation starts), then `settle` longer.
+fn wait_until_computing(
+    child: &mut Child,
+    settle: Duration,
+) -> BufReader<std::process::ChildStdout> {
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    stdout.read_line(&mut line).unwrap();
+    assert!(line.contains("degrees of freedom"), "first line: {line}");
+    std::thread::sleep(settle);
+    stdout
+}
+
+/// Sends `signal` (a name for kill(1): INT, TERM, STOP, CONT) to the child.
+fn send(child: &Child, signal: &str) {
+    let status = Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .expect("the kill command");
+    assert!(status.success(), "kill -{signal}");
+}
+
+/// Waits for the child to exit, at most `limit`; returns its status, the
+/// time it took and its stderr.
+fn wait_for_exit(child: &mut Child, limit: Duration) -> (ExitStatus, Duration, String) {
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("the process did not exit within 60 s of the signal");
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    let took = start.elapsed();
+    let mut err = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    assert!(
+        took < limit,
+        "exited {:.3} s after the signal (limit {:.3} s); stderr: {err}",
+        took.as_secs_f64(),
+        limit.as_secs_f64()
+    );
+    (status, took, err)
+}
+
+/// Waits until every thread of the child is stopped (state `T` in
+/// /proc/PID/task/*/stat), so that the signals sent next are all pending
+/// when it continues.
+fn wait_until_stopped(child: &Child) {
+    let tasks = PathBuf::from(format!("/proc/{}/task", child.id()));
+    let start = Instant::now();
+    loop {
+        let stopped = std::fs::read_dir(&tasks).unwrap().all(|t| {
+            let stat = std::fs::read_to_string(t.unwrap().path().join("stat")).unwrap_or_default();
+            // the state follows the command name in parentheses
+            stat.rsplit_once(") ")
+                .is_some_and(|(_, rest)| rest.starts_with('T'))
+        });
+        if stopped {
+            return;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "SIGSTOP took no effect"
+        );
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
+
+/// "the computation stopped X ms after the signal" of stderr.
+fn reported_stop_ms(stderr: &str) -> f64 {
+    let (_, rest) = stderr
+        .split_once("the computation stopped ")
+        .unwrap_or_else(|| panic!("no stop latency in: {stderr}"));
+    rest.split_once(" ms after the signal")
+        .and_then(|(v, _)| v.parse().ok())
+        .unwrap_or_else(|| panic!("no stop latency in: {stderr}"))
+}
+
+/// The data rows of a CSV written by flexmb.
+fn rows(csv: &Path) -> Vec<Vec<f64>> {
+    let text = std::fs::read_to_string(csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
+    text.lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+/// 44 DOF of the spatial guidance over 20 s with the explicit integrator:
+/// minutes of work, 2001 output times 0.01 s apart.
+fn long_simulation(out: &Path, integrator: &str) -> Child {
+    let scene = fixture("straight_guidance_spatial.ron");
+    let scene = scene.to_str().unwrap();
+    let args = [
+        "simulate",
+        scene,
+        "--t-end",
+        "20",
+        "--outputs",
+        "2001",
+        "--integrator",
+        integrator,
+    ];
+    start(&args, out)
+}
+
+/// A signal stops the run at the next integrator step; the rows are the
+/// output times reached and the state where it stopped.
+fn signal_stops_a_simulation(signal: &str, code: i32, integrator: &str) {
+    let out = temp_dir(&format!("{signal}-{integrator}"));
+    let mut child = long_simulation(&out, integrator);
+    let _stdout = wait_until_computing(&mut child, Duration::from_millis(300));
+    send(&child, signal);
+    let (status, took, err) = wait_for_exit(&mut child, EXIT_WITHIN);
+    assert_eq!(status.code(), Some(code), "{err}");
+    let stop_ms = reported_stop_ms(&err);
+    assert!(
+        stop_ms < STOP_WITHIN_MS,
+        "stopped {stop_ms} ms after {signal}: {err}"
+    );
+    assert!(
+        err.contains(&format!("interrupted by SIG{signal}"))
+            && err.contains("partial results written"),
+        "{err}"
+    );
+    let r = rows(&out.join("outputs.csv"));
+    assert!((1..2001).contains(&r.len()), "{} rows: partial", r.len());
+    // the explicit integrators stop after an accepted step, and the last
+    // row is the state there: after the last output time reached and
+    // before the next one (0.01 s apart); generalized-α may also stop
+    // before a step attempt (one step can take many), with the output
+    // times reached only
+    if err.contains("then the state where the run stopped") {
+        assert!(r.len() >= 2);
+        let (t_last, t_prev) = (r[r.len() - 1][0], r[r.len() - 2][0]);
+        assert!(
+            t_last > t_prev && t_last < t_prev + 0.01 + 1e-12,
+            "last rows at t = {t_prev}, {t_last}"
+        );
+    } else {
+        assert_eq!(integrator, "genalpha", "{err}");
+        for (k, row) in r.iter().enumerate() {
+            assert!(
+                (row[0] - 0.01 * k as f64).abs() < 1e-12,
+                "row {k}: t = {}",
+                row[0]
+            );
+        }
+    }
+    let csv = std::fs::read_to_string(out.join("outputs.csv")).unwrap();
+    assert!(csv.contains("# interrupted: "), "{csv}");
+    eprintln!(
+        "SIG{signal} ({integrator}): stopped {stop_ms} ms after the signal, exited after {:.1} ms",
+        1e3 * took.as_secs_f64()
+    );
     let _ = std::fs::remove_dir_all(&out);
-    // 44 DOF over 20 s with the explicit integrator: minutes of work
+}
+
+#[test]
+fn sigint_stops_a_simulation_between_steps_with_partial_results_and_exit_130() {
+    signal_stops_a_simulation("INT", 130, "dopri5");
+}
+
+#[test]
+fn sigterm_stops_a_simulation_between_steps_with_partial_results_and_exit_143() {
+    signal_stops_a_simulation("TERM", 143, "adams");
+}
+
+#[test]
+fn sigint_stops_the_implicit_integrator_between_steps_too() {
+    signal_stops_a_simulation("INT", 130, "genalpha");
+}
+
+/// Both signals arrive while the process is stopped (SIGSTOP), so both
+/// handlers run before it executes anything else: the second one exits at
+/// once, before any partial result is written. (One signal alone writes
+/// them: the tests above.)
+#[test]
+fn a_second_signal_exits_at_once() {
+    let out = temp_dir("twice");
+    let mut child = long_simulation(&out, "dopri5");
+    let _stdout = wait_until_computing(&mut child, Duration::from_millis(300));
+    send(&child, "STOP");
+    wait_until_stopped(&child);
+    send(&child, "INT");
+    send(&child, "TERM");
+    send(&child, "CONT");
+    let (status, _, err) = wait_for_exit(&mut child, EXIT_WITHIN);
+    let code = status.code();
+    assert!(code == Some(130) || code == Some(143), "{code:?}: {err}");
+    assert!(!err.contains("partial results written"), "{err}");
+    assert!(!out.join("outputs.csv").exists(), "nothing is written");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// A long held-coordinate sweep (3000 equilibria of the spatial guidance):
+/// SIGINT stops it before the next configuration or Newton iteration, with
+/// exit code 130, saying what was written.
+#[test]
+fn an_interrupted_sweep_stops_at_once_and_says_what_was_written() {
+    let out = temp_dir("sweep");
+    let scene = fixture("straight_guidance_spatial.ron");
+    let args = [
+        "sweep",
+        scene.to_str().unwrap(),
+        "--over",
+        "S.x",
+        "--from",
+        "0",
+        "--to",
+        "0.08",
+        "--n",
+        "3000",
+        "--modes",
+        "2",
+    ];
+    let mut child = start(&args, &out);
+    let _stdout = wait_until_computing(&mut child, Duration::from_millis(300));
+    send(&child, "INT");
+    let (status, _, err) = wait_for_exit(&mut child, EXIT_WITHIN);
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(reported_stop_ms(&err) < STOP_WITHIN_MS, "{err}");
+    let csv = out.join("eigenfrequencies.csv");
+    if err.contains("nothing written: stopped while finding the equilibria") {
+        assert!(!csv.exists());
+    } else {
+        assert!(err.contains("partial results written"), "{err}");
+        assert!((1..3000).contains(&rows(&csv).len()));
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `flexmb reduce` has nothing partial to write (a model from part of its
+/// reference sweep would cover less than asked): SIGTERM during its sweep
+/// of 3000 configurations (seconds of work) exits at once with 143 and
+/// writes no model.
+#[test]
+fn an_interrupted_reduction_exits_at_once_without_a_model() {
+    let dir = temp_dir("reduce");
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("model.ron");
+    let scene = fixture("straight_guidance_spatial.ron");
+    let args = [
+        "reduce",
+        scene.to_str().unwrap(),
+        "--method",
+        "fbm-svd",
+        "--modes",
+        "3",
+        "--over",
+        "load",
+        "--from",
+        "-1",
+        "--to",
+        "1",
+        "--t-load",
+        "0.05",
+        "--n",
+        "3000",
+    ];
+    let mut child = start(&args, &model);
+    let _stdout = wait_until_computing(&mut child, Duration::from_millis(300));
+    send(&child, "TERM");
+    let (status, _, err) = wait_for_exit(&mut child, EXIT_WITHIN);
+    assert_eq!(status.code(), Some(143), "{err}");
+    assert!(
+        err.contains("interrupted by SIGTERM: nothing partial to write"),
+        "{err}"
+    );
+    assert!(!model.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `flexmb info SCENE | head -1` with the reader gone before anything is
+/// printed: every write to stdout fails with BrokenPipe. No panic (it used
+/// to be exit code 101, "failed printing to stdout"), exit code 0.
+#[test]
+fn a_closed_stdout_is_no_panic_and_no_error() {
+    let scene = fixture("straight_guidance_spatial.ron");
     let mut child = Command::new(env!("CARGO_BIN_EXE_flexmb"))
-        .args(["simulate"])
-        .arg(root.join("fixtures/scenes/straight_guidance_spatial.ron"))
-        .args(["--t-end", "20", "--outputs", "2001", "--out"])
+        .arg("info")
+        .arg(&scene)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(o.status.code(), Some(0), "{err}");
+}
+
+/// A simulation whose stdout is closed still writes its files; an error
+/// with both stdout and stderr closed still gives its exit code.
+#[test]
+fn a_closed_stdout_does_not_stop_the_files_or_change_the_exit_code() {
+    let out = temp_dir("pipe");
+    let scene = fixture("straight_guidance_planar.ron");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flexmb"))
+        .arg("simulate")
+        .arg(&scene)
+        .args(["--t-end", "0.002", "--outputs", "3", "--out"])
         .arg(&out)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .expect("the kill command");
-    assert!(status.success());
-    let start = Instant::now();
-    let output = loop {
-        if let Some(_s) = child.try_wait().unwrap() {
-            break child.wait_with_output().unwrap();
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the simulation did not stop within 60 s of SIGINT"
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    };
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(130), "stderr: {stderr}");
-    assert!(stderr.contains("interrupted"), "{stderr}");
-    let csv = std::fs::read_to_string(out.join("outputs.csv")).expect("partial outputs written");
-    let rows = csv.lines().filter(|l| !l.starts_with('#')).count() - 1;
-    assert!(
-        (1..2001).contains(&rows),
-        "{rows} output rows: partial, not empty and not all"
-    );
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert_eq!(rows(&out.join("outputs.csv")).len(), 3);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flexmb"))
+        .args(["info", "/no/such/scene.ron"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    drop(child.stderr.take());
+    assert_eq!(child.wait().unwrap().code(), Some(2));
     let _ = std::fs::remove_dir_all(&out);
 }

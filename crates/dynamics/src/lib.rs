@@ -129,4 +129,7 @@ pub enum DynamicsError {
     /// The integrator failed.
     #[error("time integration failed: {0}")]
     Integration(String),
+    /// Stopped on request ([`StaticOptions::stop`]).
+    #[error("stopped on request")]
+    Interrupted,
 }

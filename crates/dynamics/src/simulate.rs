@@ -12,6 +12,7 @@ use flexmb_ode::{
 };
 use std::cell::RefCell;
 use std::rc::Rc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -54,6 +55,11 @@ pub struct SimulationOptions {
     pub atol: f64,
     /// Output times (dense output; no extra evaluations).
     pub output_times: Vec<f64>,
+    /// A request to stop, read after every accepted step (one atomic load):
+    /// when it is set the run ends there as if the observer had stopped it,
+    /// with the outputs reached so far and one more output at the step where
+    /// it stopped (e.g. set by a signal handler).
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl SimulationOptions {
@@ -67,8 +73,14 @@ impl SimulationOptions {
             output_times: (0..n)
                 .map(|k| t0 + (t_end - t0) * k as f64 / (n - 1) as f64)
                 .collect(),
+            stop: None,
         }
     }
+}
+
+/// True if `stop` is given and set: a stop was requested.
+pub(crate) fn stop_requested(stop: Option<&AtomicBool>) -> bool {
+    stop.is_some_and(|s| s.load(Ordering::Relaxed))
 }
 
 /// A computed trajectory.
@@ -84,7 +96,8 @@ pub struct Trajectory {
     pub stats: Stats,
     /// Wall time of the integration in seconds.
     pub wall_time: f64,
-    /// True if stopped early by the observer.
+    /// True if stopped early by the observer or by
+    /// [`SimulationOptions::stop`].
     pub stopped: bool,
     /// The nodal coordinates x at each output time, solved at the
     /// integrator's own configuration there (not again after the run, which
@@ -138,6 +151,10 @@ pub struct OutputPoint<'a> {
 struct Shared<'c, 's, S: ?Sized> {
     cell: &'c RefCell<&'s mut S>,
     dim: usize,
+    /// [`SimulationOptions::stop`], read after every accepted step.
+    stop: Option<&'c AtomicBool>,
+    /// (t, y) of the step at which the stop request ended the run.
+    stopped_at: Option<(f64, Vec<f64>)>,
 }
 
 impl<'c, 's, S: ?Sized> Shared<'c, 's, S> {
@@ -156,6 +173,10 @@ impl<S: OdeSystem + ?Sized> OdeSystem for Shared<'_, '_, S> {
         self.system()?.rhs(t, y, dy)
     }
     fn step_accepted(&mut self, t: f64, y: &[f64]) -> Control {
+        if stop_requested(self.stop) {
+            self.stopped_at = Some((t, y.to_vec()));
+            return Control::Stop;
+        }
         match self.system() {
             Ok(mut s) => s.step_accepted(t, y),
             Err(_) => Control::Continue,
@@ -196,15 +217,21 @@ impl<S: SecondOrderSystem + ?Sized> SecondOrderSystem for Shared<'_, '_, S> {
             Err(_) => Control::Continue,
         }
     }
+    fn stop_requested(&mut self) -> bool {
+        stop_requested(self.stop) || self.system().is_ok_and(|mut s| s.stop_requested())
+    }
 }
 
 /// Integrates a first-order system y' = f(t, y) with one of the explicit
 /// integrators (Dopri5 or Adams) from (t0, y0) to the last output time of
 /// `opts`; `observer(sys, t, y)` sees each output, with the system in the
 /// state of the integrator's last evaluation (e.g. to solve the output's
-/// configuration from there), and may stop the run. Returns the
-/// integrator's statistics and whether the observer stopped it. Reduced
-/// models use this exactly like the unreduced equations of motion.
+/// configuration from there), and may stop the run, as does
+/// [`SimulationOptions::stop`] after any accepted step: the observer then
+/// also sees the state at that step (after the last output time reached),
+/// so the partial result ends where the run stopped. Returns the
+/// integrator's statistics and whether the run was stopped. Reduced models
+/// use this exactly like the unreduced equations of motion.
 pub fn integrate_explicit<S: OdeSystem + ?Sized>(
     sys: &mut S,
     opts: &SimulationOptions,
@@ -233,11 +260,20 @@ fn integrate_explicit_named<S: OdeSystem + ?Sized>(
     let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(describe(&e));
     let dim = sys.dim();
     let cell = RefCell::new(sys);
-    let mut shared = Shared { cell: &cell, dim };
-    let mut observe = |t: f64, y: &[f64]| match cell.try_borrow_mut() {
-        Ok(mut s) => observer(&mut **s, t, y),
-        // (unreachable: the integrator is not evaluating the system)
-        Err(_) => Control::Stop,
+    let mut shared = Shared {
+        cell: &cell,
+        dim,
+        stop: opts.stop.as_deref(),
+        stopped_at: None,
+    };
+    let last_output = std::cell::Cell::new(f64::NEG_INFINITY);
+    let mut observe = |t: f64, y: &[f64]| {
+        last_output.set(t);
+        match cell.try_borrow_mut() {
+            Ok(mut s) => observer(&mut **s, t, y),
+            // (unreachable: the integrator is not evaluating the system)
+            Err(_) => Control::Stop,
+        }
     };
     let sol = match opts.integrator {
         Integrator::Dopri5 => {
@@ -266,6 +302,11 @@ fn integrate_explicit_named<S: OdeSystem + ?Sized>(
             ))
         }
     };
+    if let Some((t, y)) = shared.stopped_at.take() {
+        if t > last_output.get() {
+            observe(t, &y);
+        }
+    }
     Ok((
         sol.stats.clone(),
         !matches!(sol.status, flexmb_ode::Status::Completed),
@@ -379,6 +420,10 @@ impl OdeSystem for FirstOrder<'_> {
 struct Residual<'a> {
     dy: &'a mut Dynamics,
     watch: StepWatch,
+    /// [`SimulationOptions::stop`], read after every accepted step.
+    stop: Option<&'a AtomicBool>,
+    /// (t, q, q̇) of the step at which the stop request ended the run.
+    stopped_at: Option<StateAt>,
 }
 
 impl SecondOrderSystem for Residual<'_> {
@@ -417,7 +462,16 @@ impl SecondOrderSystem for Residual<'_> {
         Ok(())
     }
     fn step_accepted(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Control {
+        if stop_requested(self.stop) {
+            self.stopped_at = Some((t, q.to_vec(), qd.to_vec()));
+            return Control::Stop;
+        }
         self.watch.accepted(self.dy, t, q, qd)
+    }
+    /// Also before every step attempt: one accepted step can take several
+    /// Newton failures, tangents and retries (the first steps of a run do).
+    fn stop_requested(&mut self) -> bool {
+        stop_requested(self.stop)
     }
 }
 
@@ -534,7 +588,9 @@ impl Dynamics {
 
     /// Integrates from (t0, q0, q̇0) to the last output time; `observer` sees
     /// each output point with a [`Dynamics`] solved there, and may stop the
-    /// run (partial results are kept).
+    /// run (partial results are kept), as may [`SimulationOptions::stop`]
+    /// after any accepted step (the trajectory then ends with an output at
+    /// that step).
     ///
     /// Free orientation nodes (three Euler parameters as DOFs) switch their
     /// chart when the dependent parameter gets small
@@ -692,12 +748,24 @@ impl Dynamics {
                     atol: Tolerance::Scalar(opts.atol),
                     ..Default::default()
                 };
-                let mut sys = Residual { dy: self, watch };
+                let mut sys = Residual {
+                    dy: self,
+                    watch,
+                    stop: opts.stop.as_deref(),
+                    stopped_at: None,
+                };
+                let mut last_output = f64::NEG_INFINITY;
                 let sol = GeneralizedAlpha::new(o)
                     .solve_with(&mut sys, t0, q0, qd0, t_end, &out, |t, q, qd, _| {
+                        last_output = t;
                         emit(t, q, qd)
                     })
                     .map_err(|e| sys.watch.with_cause(to_err(e)))?;
+                if let Some((t, q, qd)) = sys.stopped_at.take() {
+                    if t > last_output {
+                        emit(t, &q, &qd);
+                    }
+                }
                 let stopped = !matches!(sol.status, flexmb_ode::Status::Completed);
                 (sol.stats.clone(), stopped, sys.watch.switch_at)
             }

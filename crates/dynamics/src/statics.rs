@@ -7,6 +7,8 @@ use faer::Mat;
 use flexmb_kinematics::DenseLu;
 use flexmb_model::{Coordinate, Load};
 use flexmb_rotation::EulerParameters;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 /// Settings of the static solver.
 #[derive(Clone, Debug)]
@@ -30,6 +32,10 @@ pub struct StaticOptions {
     /// equilibrium that already carries them, e.g. the previous sweep point).
     /// Held values are always ramped from their values in `q0`.
     pub ramp_loads: bool,
+    /// A request to stop, read before every Newton iteration (one atomic
+    /// load): when it is set the solve ends with
+    /// [`DynamicsError::Interrupted`] (e.g. set by a signal handler).
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl Default for StaticOptions {
@@ -41,6 +47,7 @@ impl Default for StaticOptions {
             held: vec![],
             min_increment: 1e-4,
             ramp_loads: true,
+            stop: None,
         }
     }
 }
@@ -496,6 +503,10 @@ impl Dynamics {
             let mut guard_budget = RESIDUAL_GUARD_BUDGET;
             let mut last_was_chord = false;
             while steps < opts.max_iterations {
+                if crate::simulate::stop_requested(opts.stop.as_deref()) {
+                    self.load_factor = 1.0;
+                    return Err(DynamicsError::Interrupted);
+                }
                 iterations += 1;
                 // chord Newton: keep the factorized tangent (of an earlier
                 // iterate, increment or call) while its steps shrink by at

@@ -39,7 +39,7 @@ pub use modes::{
     asymmetry, buckling_factors, damped_modes, generalized_symmetric, undamped_modes, DampedMode,
     Modes,
 };
-pub use sweep::{sweep, SweepOptions, SweepParameter, SweepPoint};
+pub use sweep::{sweep, sweep_until, SweepOptions, SweepOutcome, SweepParameter, SweepPoint};
 
 use faer::Mat;
 

@@ -5,13 +5,15 @@
 
 use crate::{undamped_modes, LinearizeError, Modes};
 use faer::Mat;
-use flexmb_dynamics::{short_number, Dynamics, StaticOptions};
+use flexmb_dynamics::{short_number, Dynamics, DynamicsError, StaticOptions};
 use flexmb_model::Mechanism;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-/// Modes and mass matrices of one worker's block of configurations.
-type BlockResult = Result<Vec<(Modes, Mat<f64>)>, LinearizeError>;
+/// Modes and mass matrices of one worker's block of configurations, with
+/// each configuration's index (the block's first ones if stopped).
+type BlockResult = Result<Vec<(usize, Modes, Mat<f64>)>, LinearizeError>;
 
 /// What varies along the sweep.
 pub enum SweepParameter {
@@ -103,6 +105,39 @@ pub fn sweep(
     opts: &SweepOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<SweepPoint>, LinearizeError> {
+    sweep_until(mech, param, opts, progress, None).map(|o| o.points)
+}
+
+/// What a sweep that may be stopped ([`sweep_until`]) computed.
+#[derive(Clone, Debug)]
+pub struct SweepOutcome {
+    /// The configurations completed (equilibrium and modes), in the order of
+    /// the sweep values; all of them unless stopped.
+    pub points: Vec<SweepPoint>,
+    /// How many equilibria were found (all n unless stopped in the first
+    /// phase, which then computes no modes).
+    pub equilibria: usize,
+    /// True if the stop request ended the sweep early.
+    pub stopped: bool,
+}
+
+/// True if `stop` is given and set.
+fn requested(stop: Option<&Arc<AtomicBool>>) -> bool {
+    stop.is_some_and(|s| s.load(Ordering::Relaxed))
+}
+
+/// [`sweep`] that ends early when `stop` is set: it is read before every
+/// configuration of both phases and by every Newton iteration of the
+/// equilibria ([`StaticOptions::stop`]). A sweep stopped while finding the
+/// equilibria has no modes; one stopped in the eigen analyses returns the
+/// configurations that are done.
+pub fn sweep_until(
+    mech: &Arc<Mechanism>,
+    param: &SweepParameter,
+    opts: &SweepOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    stop: Option<&Arc<AtomicBool>>,
+) -> Result<SweepOutcome, LinearizeError> {
     let n = opts.values.len();
     let total = 2 * n;
     let mut dy = Dynamics::new(mech.clone());
@@ -113,9 +148,13 @@ pub fn sweep(
     let mut xs = Vec::with_capacity(n);
     // phase 1: equilibria by continuation
     for (i, &s) in opts.values.iter().enumerate() {
+        if requested(stop) {
+            return Ok(stopped_early(i));
+        }
         // the first equilibrium ramps the loads; the next ones continue from it
         let mut so = StaticOptions {
             ramp_loads: i == 0,
+            stop: stop.cloned(),
             ..Default::default()
         };
         match param {
@@ -126,9 +165,11 @@ pub fn sweep(
                 so.held = dofs.iter().copied().zip(v).collect();
             }
         }
-        let sol = dy
-            .static_equilibrium(opts.t, &q, &so)
-            .map_err(|e| failed_at(mech, param, opts, i, e.to_string()))?;
+        let sol = match dy.static_equilibrium(opts.t, &q, &so) {
+            Ok(sol) => sol,
+            Err(DynamicsError::Interrupted) => return Ok(stopped_early(i)),
+            Err(e) => return Err(failed_at(mech, param, opts, i, e.to_string())),
+        };
         q = sol.q;
         qs.push(q.clone());
         xs.push(sol.x);
@@ -156,6 +197,7 @@ pub fn sweep(
             block
                 .iter()
                 .enumerate()
+                .take_while(|_| !requested(stop))
                 .map(|(j, q)| {
                     let i = c * chunk + j;
                     dy.set_load_scale(scale[i]);
@@ -166,26 +208,37 @@ pub fn sweep(
                         .map_err(|e| fail(e.to_string()))?;
                     let modes =
                         undamped_modes(&lin, opts.modes).map_err(|e| fail(e.to_string()))?;
-                    let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    let d = done.fetch_add(1, Ordering::Relaxed) + 1;
                     progress(d, total);
-                    Ok((modes, lin.m))
+                    Ok((i, modes, lin.m))
                 })
                 .collect()
         })
         .collect();
-    let mut out = Vec::with_capacity(n);
-    let mut i = 0;
+    let mut points = Vec::with_capacity(n);
     for r in results {
-        for (modes, m) in r? {
-            out.push(SweepPoint {
+        for (i, modes, m) in r? {
+            points.push(SweepPoint {
                 s: opts.values[i],
                 q: qs[i].clone(),
                 frequencies_hz: modes.frequencies_hz(),
                 modes: opts.keep_vectors.then(|| modes.vectors.clone()),
                 mass: opts.keep_vectors.then_some(m),
             });
-            i += 1;
         }
     }
-    Ok(out)
+    Ok(SweepOutcome {
+        stopped: points.len() < n,
+        points,
+        equilibria: n,
+    })
+}
+
+/// The outcome of a sweep stopped after `equilibria` equilibria.
+fn stopped_early(equilibria: usize) -> SweepOutcome {
+    SweepOutcome {
+        points: vec![],
+        equilibria,
+        stopped: true,
+    }
 }

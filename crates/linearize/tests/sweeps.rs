@@ -88,3 +88,59 @@ fn mode_shapes_in_nodal_coordinates_move_the_body_in_x_for_the_first_mode() {
     let (vx, vz) = (shapes[(sx[0], 1)].abs(), shapes[(sx[2], 1)].abs());
     assert!(vz > 100.0 * vx, "mode 2 at S: x {vx}, z {vz}");
 }
+
+/// A sweep stopped from outside ([`sweep_until`]): requested after two
+/// equilibria it has no modes and says how many equilibria it found;
+/// requested after the first eigen analysis it returns the configurations
+/// done (the parallel workers stop before their next one); never requested,
+/// it is the whole sweep.
+#[test]
+fn a_stopped_sweep_returns_what_is_done() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let mech = guidance(vec![Select::Coord("S".into(), Component::X)]);
+    let x0 = mech.q0()[0];
+    let n = 12;
+    let opts = SweepOptions {
+        values: (0..n).map(|i| x0 + 0.005 * i as f64).collect(),
+        modes: 2,
+        t: 0.0,
+        keep_vectors: false,
+    };
+    let run = |stop_after: usize| {
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = stop.clone();
+        let progress = move |done: usize, _: usize| {
+            if done == stop_after {
+                flag.store(true, Ordering::Relaxed);
+            }
+        };
+        sweep_until(
+            &mech,
+            &SweepParameter::Dof(0),
+            &opts,
+            &progress,
+            Some(&stop),
+        )
+        .unwrap()
+    };
+    let o = run(2);
+    assert!(
+        o.stopped && o.points.is_empty() && o.equilibria == 2,
+        "{o:?}"
+    );
+    let o = run(n + 1);
+    assert!(o.stopped && o.equilibria == n, "{o:?}");
+    // each worker finishes the configuration it is at (with a thread per
+    // configuration all of them would be done)
+    let threads = rayon::current_num_threads();
+    assert!(!o.points.is_empty() && o.points.len() <= threads.min(n));
+    if threads < n {
+        assert!(o.points.len() < n, "{} points", o.points.len());
+    }
+    // the points done are in the order of the values, each at its value
+    for w in o.points.windows(2) {
+        assert!(w[0].s < w[1].s);
+    }
+    let o = run(usize::MAX);
+    assert!(!o.stopped && o.points.len() == n && o.equilibria == n);
+}

@@ -639,6 +639,11 @@ impl GeneralizedAlpha {
             }
             let mut rejected = false;
             let (t1, theta_max, err) = loop {
+                if sys.stop_requested() {
+                    sink.solution.status = Status::Stopped { t };
+                    sink.solution.stats = stats;
+                    return Ok(sink.solution);
+                }
                 let h_min = 16.0 * spacing(t);
                 if h < h_min {
                     return Err(OdeError::StepSizeTooSmall { t, h, h_min });

@@ -96,6 +96,16 @@ pub trait SecondOrderSystem {
     fn step_accepted(&mut self, _t: f64, _q: &[f64], _qd: &[f64]) -> Control {
         Control::Continue
     }
+
+    /// Asked before every step attempt, accepted or rejected: `true` ends
+    /// the integration at the last accepted step with
+    /// [`Status::Stopped`](crate::Status::Stopped). For a stop requested
+    /// from outside (a signal) that must not wait for the next accepted
+    /// step, which for an implicit method can take many Newton iterations
+    /// and tangents. The default never stops.
+    fn stop_requested(&mut self) -> bool {
+        false
+    }
 }
 
 impl<S: SecondOrderSystem + ?Sized> SecondOrderSystem for &mut S {
@@ -126,6 +136,9 @@ impl<S: SecondOrderSystem + ?Sized> SecondOrderSystem for &mut S {
     }
     fn step_accepted(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Control {
         (**self).step_accepted(t, q, qd)
+    }
+    fn stop_requested(&mut self) -> bool {
+        (**self).stop_requested()
     }
 }
 
