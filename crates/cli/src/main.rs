@@ -76,9 +76,10 @@ enum Command {
     Eig {
         /// Scene file (RON).
         scene: PathBuf,
-        /// Number of modes, at least 1.
-        #[arg(long, default_value_t = 10, allow_negative_numbers = true)]
-        modes: usize,
+        /// Number of modes, at least 1 [default: 10, or every degree of
+        /// freedom if there are fewer].
+        #[arg(long, allow_negative_numbers = true)]
+        modes: Option<usize>,
         /// Linearize at the static equilibrium under the scene's loads and gravity.
         #[arg(long)]
         static_first: bool,
@@ -153,9 +154,10 @@ struct SweepArgs {
     /// Number of configurations, at least 2 (--from and --to).
     #[arg(long, default_value_t = 50, allow_negative_numbers = true)]
     n: usize,
-    /// Modes per configuration, at least 1.
-    #[arg(long, default_value_t = 6, allow_negative_numbers = true)]
-    modes: usize,
+    /// Modes per configuration, at least 1 [default: 6, or every degree of
+    /// freedom if there are fewer].
+    #[arg(long, allow_negative_numbers = true)]
+    modes: Option<usize>,
     /// Time at which the scene's loads are evaluated (a load sweep scales
     /// them: pick a time where they act, e.g. the peak of a pulse).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -467,10 +469,12 @@ fn simulate_unreduced(
 
 /// `flexmb eig`: the first `k` eigenfrequencies at the reference
 /// configuration or the static equilibrium, damped modes and buckling.
-fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), Failure> {
-    options::at_least("--modes", k, 1, "the number of modes")?;
+fn eig(path: &Path, modes: Option<usize>, static_first: bool, buckling: bool) -> Result<(), Failure> {
+    if let Some(k) = modes {
+        options::at_least("--modes", k, 1, "the number of modes")?;
+    }
     let (_, mech) = load(path)?;
-    options::at_most_dofs("--modes", k, &mech)?;
+    let k = options::modes_or_default(modes, 10, &mech)?;
     let mut dy = Dynamics::new(mech.clone());
     let mut q = mech.q0();
     if static_first {
@@ -537,7 +541,7 @@ fn eig(path: &Path, k: usize, static_first: bool, buckling: bool) -> Result<(), 
 /// `flexmb sweep`: eigenfrequencies at static equilibria along a load scale
 /// or a held coordinate (unreduced), or along a load scale (reduced model).
 fn sweep(a: &SweepArgs) -> Result<(), Failure> {
-    let (over, n, k) = (a.over.as_str(), a.n, a.modes);
+    let (over, n) = (a.over.as_str(), a.n);
     check_sweep_options(a)?;
     let values = linspace(a.from, a.to, n);
     if let Some(model) = &a.reduced {
@@ -598,7 +602,7 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         };
         (mech, param)
     };
-    options::at_most_dofs("--modes", k, &mech)?;
+    let k = options::modes_or_default(a.modes, 6, &mech)?;
     options::writable_dir("--out", &a.out)?;
     say!("{}", mech.summary());
     let pb = count_bar(2 * n as u64, "equilibria, then eigen analyses");
@@ -665,7 +669,9 @@ fn check_sweep_options(a: &SweepArgs) -> Result<(), Failure> {
         2,
         "the number of configurations, from --from to --to",
     )?;
-    options::at_least("--modes", a.modes, 1, "the modes per configuration")?;
+    if let Some(k) = a.modes {
+        options::at_least("--modes", k, 1, "the modes per configuration")?;
+    }
     options::finite("--from", a.from)?;
     options::finite("--to", a.to)?;
     options::finite("--t-load", a.t_load)?;
@@ -690,14 +696,14 @@ fn sweep_command_line(a: &SweepArgs) -> String {
         .as_ref()
         .map(|m| format!(" --reduced {}", m.display()))
         .unwrap_or_default();
+    let modes = a.modes.map(|k| format!(" --modes {k}")).unwrap_or_default();
     format!(
-        "flexmb sweep {}{reduced} --over {} --from {} --to {} --n {} --modes {} --t-load {}",
+        "flexmb sweep {}{reduced} --over {} --from {} --to {} --n {}{modes} --t-load {}",
         a.scene.display(),
         a.over,
         a.from,
         a.to,
         a.n,
-        a.modes,
         a.t_load
     )
 }

@@ -17,6 +17,19 @@ pub(crate) fn at_least(option: &str, value: usize, min: usize, why: &str) -> Res
     Ok(())
 }
 
+/// The number of modes: `--modes` if given (at most the degrees of
+/// freedom), else `default` or every degree of freedom if there are fewer.
+pub(crate) fn modes_or_default(
+    modes: Option<usize>,
+    default: usize,
+    mech: &Mechanism,
+) -> Result<usize, Failure> {
+    match modes {
+        Some(k) => at_most_dofs("--modes", k, mech).map(|_| k),
+        None => Ok(default.min(mech.n_dof())),
+    }
+}
+
 /// `modes` of `option` must not exceed the mechanism's degrees of freedom.
 pub(crate) fn at_most_dofs(option: &str, modes: usize, mech: &Mechanism) -> Result<(), Failure> {
     let n = mech.n_dof();

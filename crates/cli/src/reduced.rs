@@ -122,8 +122,9 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
     let (_, mut red) = load_model(&mech, model)?;
     crate::options::writable_dir("--out", &a.out)?;
     let n = values.len();
-    let k = a.modes.min(red.n_z());
-    if k < a.modes {
+    let asked = a.modes.unwrap_or(6);
+    let k = asked.min(red.n_z());
+    if k < asked {
         say!(
             "the reduced model has {} coordinates: {k} eigenfrequencies per configuration",
             red.n_z()
