@@ -469,7 +469,12 @@ fn simulate_unreduced(
 
 /// `flexmb eig`: the first `k` eigenfrequencies at the reference
 /// configuration or the static equilibrium, damped modes and buckling.
-fn eig(path: &Path, modes: Option<usize>, static_first: bool, buckling: bool) -> Result<(), Failure> {
+fn eig(
+    path: &Path,
+    modes: Option<usize>,
+    static_first: bool,
+    buckling: bool,
+) -> Result<(), Failure> {
     if let Some(k) = modes {
         options::at_least("--modes", k, 1, "the number of modes")?;
     }
@@ -642,6 +647,10 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         s: pts.iter().map(|p| p.s).collect(),
         frequencies: pts.iter().map(|p| p.frequencies_hz.clone()).collect(),
         modes: k,
+        holding: (
+            held_names(&mech, &param),
+            pts.iter().map(|p| p.holding.clone()).collect(),
+        ),
     };
     let mut comments = vec![
         sweep_command_line(a),
@@ -687,6 +696,22 @@ fn sweep_parameter_name(over: &str) -> String {
     } else {
         format!("{over} change")
     }
+}
+
+/// The names of the coordinates a sweep holds (none for a load sweep).
+fn held_names(
+    mech: &flexmb_model::Mechanism,
+    param: &flexmb_linearize::SweepParameter,
+) -> Vec<String> {
+    use flexmb_linearize::SweepParameter;
+    let dofs: &[usize] = match param {
+        SweepParameter::LoadScale => &[],
+        SweepParameter::Dof(k) => std::slice::from_ref(k),
+        SweepParameter::Path { dofs, .. } => dofs,
+    };
+    dofs.iter()
+        .map(|k| mech.coordinate_name(mech.dofs[*k]).to_string())
+        .collect()
 }
 
 /// The command line of a sweep, for the CSV header.

@@ -172,6 +172,7 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
         s: values[..done].to_vec(),
         frequencies: freqs,
         modes: k,
+        holding: (vec![], vec![]),
     };
     let mut comments = vec![
         crate::sweep_command_line(a),

@@ -146,10 +146,16 @@ pub(crate) struct FrequencySweep<'a> {
     pub frequencies: Vec<Vec<f64>>,
     /// Number of modes (columns).
     pub modes: usize,
+    /// The held coordinates' names and, at each value, the generalized
+    /// forces that hold them (a sweep over held coordinates; empty
+    /// otherwise).
+    pub holding: (Vec<String>, Vec<Vec<f64>>),
 }
 
-/// Writes `out/eigenfrequencies.csv` (the parameter, f1_hz … fk_hz) and
-/// `out/eigenfrequencies.svg`.
+/// Writes `out/eigenfrequencies.csv` (the parameter, f1_hz … fk_hz, and
+/// `hold:NAME` for each held coordinate: the force that holds it) and
+/// `out/eigenfrequencies.svg`, plus `out/holding_force.svg` for a sweep over
+/// held coordinates.
 pub(crate) fn write_frequency_sweep(
     sw: &FrequencySweep,
     comments: &[String],
@@ -165,14 +171,19 @@ pub(crate) fn write_frequency_sweep(
         })?;
     }
     std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
+    let (held, forces) = &sw.holding;
     let mut header = vec![sw.parameter.clone()];
     header.extend((1..=sw.modes).map(|i| format!("f{i}_hz")));
+    header.extend(held.iter().map(|h| format!("hold:{h}")));
     let rows: Vec<Vec<f64>> =
         sw.s.iter()
             .zip(&sw.frequencies)
-            .map(|(s, f)| {
+            .enumerate()
+            .map(|(r, (s, f))| {
+                let hold = forces.get(r).into_iter().flatten().copied();
                 std::iter::once(*s)
                     .chain((0..sw.modes).map(|i| f.get(i).copied().unwrap_or(f64::NAN)))
+                    .chain(hold)
                     .collect()
             })
             .collect();
@@ -190,5 +201,19 @@ pub(crate) fn write_frequency_sweep(
     let svg = out.join("eigenfrequencies.svg");
     plot.save(&svg).map_err(|e| io_err(e, &svg))?;
     say!("wrote {} and {}", csv.display(), svg.display());
+    if !held.is_empty() {
+        let mut plot = Plot::new(
+            &format!("{}: force holding the swept coordinates", sw.title),
+            &sw.parameter,
+            "generalized holding force (N, N m)",
+        );
+        for (k, h) in held.iter().enumerate() {
+            let f: Vec<f64> = rows.iter().map(|r| r[1 + sw.modes + k]).collect();
+            plot.push(Series::line(h, &sw.s, &f));
+        }
+        let svg = out.join("holding_force.svg");
+        plot.save(&svg).map_err(|e| io_err(e, &svg))?;
+        say!("wrote {}", svg.display());
+    }
     Ok(())
 }

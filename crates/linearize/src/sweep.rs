@@ -50,6 +50,11 @@ pub struct SweepPoint {
     pub s: f64,
     /// The equilibrium DOFs.
     pub q: Vec<f64>,
+    /// The generalized forces that hold the held DOFs at their values (the
+    /// actuation force along the stroke; [`SweepParameter::Dof`] and
+    /// [`SweepParameter::Path`], in their order), from the static
+    /// out-of-balance at the equilibrium; empty for a load sweep.
+    pub holding: Vec<f64>,
     /// Undamped eigenfrequencies (Hz).
     pub frequencies_hz: Vec<f64>,
     /// Mode shapes (if kept).
@@ -146,6 +151,7 @@ pub fn sweep_until(
     // the configuration of each equilibrium: the linearization's position
     // solve starts there, not at the reference or at a neighbouring block
     let mut xs = Vec::with_capacity(n);
+    let mut holding = Vec::with_capacity(n);
     // phase 1: equilibria by continuation
     for (i, &s) in opts.values.iter().enumerate() {
         if requested(stop) {
@@ -173,6 +179,7 @@ pub fn sweep_until(
         q = sol.q;
         qs.push(q.clone());
         xs.push(sol.x);
+        holding.push(sol.reactions);
         progress(i + 1, total);
     }
     // phase 2: linearization and eigen analysis in parallel
@@ -221,6 +228,7 @@ pub fn sweep_until(
             points.push(SweepPoint {
                 s: opts.values[i],
                 q: qs[i].clone(),
+                holding: holding[i].clone(),
                 frequencies_hz: modes.frequencies_hz(),
                 modes: opts.keep_vectors.then(|| modes.vectors.clone()),
                 mass: opts.keep_vectors.then_some(m),
