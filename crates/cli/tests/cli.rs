@@ -134,8 +134,11 @@ fn eig_and_sweep_report_frequencies() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let (h, rows) = flexmb_plot_read(&out.join("eigenfrequencies.csv"));
-    assert_eq!(h, vec!["S.x change", "f1_hz", "f2_hz"]);
+    assert_eq!(h, vec!["S.x change", "f1_hz", "f2_hz", "hold:S.x"]);
     assert_eq!(rows.len(), 9);
+    // the force that holds S.x: zero at the reference, growing along the stroke
+    assert!(rows[0][3].abs() < 1e-6, "{}", rows[0][3]);
+    assert!(rows.windows(2).all(|w| w[1][3] > w[0][3]));
     // the out-of-plane mode drops sharply over the stroke (thesis Fig. 6.9b)
     assert!(
         rows[8][2] < 0.5 * rows[0][2],

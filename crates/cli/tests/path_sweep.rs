@@ -23,9 +23,14 @@ fn flexmb(args: &[&str]) -> std::process::Output {
 }
 
 /// The eigenfrequency rows (without the sweep parameter) of a sweep's CSV.
+/// The f*_hz columns of a sweep's CSV (not the parameter or the `hold:`
+/// columns of the forces that hold the path's coordinates).
 fn frequencies(dir: &Path) -> Vec<Vec<f64>> {
-    let (_, rows) = flexmb_plot::read_csv(&dir.join("eigenfrequencies.csv")).unwrap();
-    rows.into_iter().map(|r| r[1..].to_vec()).collect()
+    let (h, rows) = flexmb_plot::read_csv(&dir.join("eigenfrequencies.csv")).unwrap();
+    let cols: Vec<usize> = (0..h.len()).filter(|k| h[*k].ends_with("_hz")).collect();
+    rows.into_iter()
+        .map(|r| cols.iter().map(|k| r[*k]).collect())
+        .collect()
 }
 
 #[test]
