@@ -332,7 +332,7 @@ fn scene_rows(k: &mut Catalogue) {
         k.case(what, 2, culprit, &["info", &scene]);
     }
     // unphysical or inconsistent data
-    let rows: [(&'static str, &[&str], &str, &str, &str); 11] = [
+    let rows: [(&'static str, &[&str], &str, &str, &str); 12] = [
         (
             "negative Young's modulus",
             &["material 'steel'", "e (Young's modulus)"],
@@ -381,6 +381,17 @@ fn scene_rows(k: &mut Catalogue) {
             "n_zero.ron",
             "n: 5",
             "n: 0",
+        ),
+        (
+            "a chain too long for the chain helper (issue 14 item 6)",
+            &[
+                "element 'flexure1'",
+                "1000000000 elements in one chain",
+                "allows",
+            ],
+            "n_huge.ron",
+            "n: 5",
+            "n: 1000000000",
         ),
         (
             "spatial node in a planar scene",
