@@ -191,10 +191,17 @@ enum Failure {
 /// Reads a scene and builds its mechanism.
 fn load(path: &Path) -> Result<(Scene, Arc<flexmb_model::Mechanism>), Failure> {
     let scene = Scene::load(path).map_err(|e| Failure::Input(e.to_string()))?;
-    let mech = scene
-        .build(path.parent())
-        .map_err(|e| Failure::Input(e.to_string()))?;
+    let mech = build(&scene, path)?;
     Ok((scene, Arc::new(mech)))
+}
+
+/// Builds the mechanism of `scene` (read from `path`), with a spinner while
+/// it takes (the DOF choice of a large model).
+fn build(scene: &Scene, path: &Path) -> Result<flexmb_model::Mechanism, Failure> {
+    let spinner = report::spinner("building the mechanism and choosing its degrees of freedom");
+    let mech = scene.build(path.parent());
+    spinner.finish_and_clear();
+    mech.map_err(|e| Failure::Input(e.to_string()))
 }
 
 /// A failed write.
@@ -558,9 +565,7 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         return Err(Failure::Input("--path needs `--over path`".into()));
     }
     let (mech, param) = if over == "load" {
-        let mech = scene
-            .build(path.parent())
-            .map_err(|e| Failure::Input(e.to_string()))?;
+        let mech = build(&scene, path)?;
         (Arc::new(mech), flexmb_linearize::SweepParameter::LoadScale)
     } else if over == "path" {
         let file = a
@@ -586,18 +591,12 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         (Arc::new(mech), param)
     } else {
         // make the coordinate a degree of freedom, then hold it
-        let probe = scene
-            .build(path.parent())
-            .map_err(|e| Failure::Input(e.to_string()))?;
+        let probe = build(&scene, path)?;
         let select = coords::selection(&probe, over)?.ok_or_else(|| {
             Failure::Input(format!("'{over}' is neither `load` nor a coordinate or deformation of the scene (see `flexmb info`)"))
         })?;
         scene.dofs_first.insert(0, select);
-        let mech = Arc::new(
-            scene
-                .build(path.parent())
-                .map_err(|e| Failure::Input(e.to_string()))?,
-        );
+        let mech = Arc::new(build(&scene, path)?);
         let k = coords::dof_index(&mech, over, "--over")?;
         // the sweep parameter is the change from the reference configuration
         let q_ref = mech.q0()[k];

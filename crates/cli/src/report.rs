@@ -33,6 +33,20 @@ pub(crate) fn count_bar(len: u64, message: &str) -> ProgressBar {
     pb
 }
 
+/// A spinner with the elapsed time for a set-up phase of unknown length
+/// (building a large mechanism: the DOF choice of 10⁵ coordinates takes
+/// seconds), drawn on a terminal only and ticking on its own thread.
+pub(crate) fn spinner(message: &str) -> ProgressBar {
+    let pb = ProgressBar::new_spinner();
+    pb.set_style(
+        ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    pb.set_message(message.to_string());
+    pb.enable_steady_tick(std::time::Duration::from_millis(120));
+    pb
+}
+
 /// A progress bar over simulated time (per mille of the end time).
 pub(crate) fn time_bar() -> ProgressBar {
     let pb = ProgressBar::new(1000);
