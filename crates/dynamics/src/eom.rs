@@ -692,7 +692,9 @@ impl Dynamics {
         &self.mq
     }
 
-    /// Energies at (q, q̇, t).
+    /// Energies at (q, q̇, t); an error naming the element at which an
+    /// energy stops being finite (e.g. T = ½mv² overflowing for a velocity
+    /// of 1e200), not a non-finite value.
     pub fn energies(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Result<Energies, DynamicsError> {
         self.kinematics_at(t, q, Some(qd))?;
         let mech = self.mech.clone();
@@ -703,7 +705,7 @@ impl Dynamics {
         };
         let mut xl = [0.0; 64];
         let mut vl = [0.0; 64];
-        for e in &mech.elements {
+        for (index, e) in mech.elements.iter().enumerate() {
             let n = e.x_index.len();
             for (k, gi) in e.x_index.iter().enumerate() {
                 xl[k] = x[*gi];
@@ -725,6 +727,19 @@ impl Dynamics {
                 if !rigid {
                     en.elastic += e.element.elastic_energy(&eps[o..o + ne]);
                 }
+            }
+            let sums = [
+                ("kinetic energy", en.kinetic),
+                ("elastic energy", en.elastic),
+                ("gravitational potential", en.gravitational),
+            ];
+            if let Some((what, _)) = sums.iter().find(|(_, v)| !v.is_finite()) {
+                return Err(DynamicsError::NonFinite {
+                    what,
+                    index,
+                    name: format!("element '{}' (the sum up to it)", e.id),
+                    t,
+                });
             }
         }
         Ok(en)

@@ -1,0 +1,49 @@
+//! Inputs found by `cargo xtask fuzz` (issue 14 item 8) that broke the
+//! contract of the dynamics layer: a result is finite or an error that names
+//! the culprit. Each test failed before its fix.
+
+use flexmb_dynamics::{Dynamics, DynamicsError};
+use flexmb_model::Scene;
+use std::sync::Arc;
+
+/// Case 0x37ab83c1f0171e7b (seed 0x1f, from `fixtures/fuzz/planar_explicit_dofs.ron`
+/// with an initial angular velocity of −1e308 rad/s about the origin),
+/// reduced: a free point mass 0.7 m from the origin gets ẋ = −7e307 m/s,
+/// finite, and ½mv² overflows. `energies` returned Ok with T = inf.
+#[test]
+fn an_overflowing_kinetic_energy_is_an_error_naming_the_element() {
+    let scene = Scene::from_ron_str(
+        r#"(
+        dimension: Planar,
+        nodes: [ (id: "C", at: [-0.1, -0.7]) ],
+        elements: [ (id: "mc", type: PointMass(node: "C", mass: 0.2)) ],
+        initial_velocity: [ (nodes: ["C"], omega: Some([0.0, 0.0, -1e308])) ],
+    )"#,
+    )
+    .unwrap();
+    let mech = Arc::new(scene.build(None).unwrap());
+    let mut dy = Dynamics::new(mech.clone());
+    let q0 = mech.q0();
+    let qd0 = dy.initial_qd(0.0, &q0).unwrap();
+    assert!(
+        qd0.iter().all(|v| v.is_finite()) && qd0[0].abs() > 1e307,
+        "{qd0:?}"
+    );
+    let e = dy.energies(0.0, &q0, &qd0);
+    match &e {
+        Err(DynamicsError::NonFinite { what, name, .. }) => {
+            assert_eq!(*what, "kinetic energy");
+            assert!(name.contains("element 'mc'"), "{name}");
+        }
+        other => panic!("expected a non-finite kinetic energy, got {other:?}"),
+    }
+    let msg = e.unwrap_err().to_string();
+    assert!(
+        msg.contains("non-finite kinetic energy of element 'mc'"),
+        "{msg}"
+    );
+    // a finite one is still computed
+    let slow = vec![1.0; qd0.len()];
+    let t = dy.energies(0.0, &q0, &slow).unwrap();
+    assert!((t.kinetic - 0.5 * 0.2 * 2.0).abs() < 1e-12, "{t:?}");
+}
