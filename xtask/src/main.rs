@@ -128,7 +128,7 @@ fn main() -> ExitCode {
             };
             match (case, input) {
                 (Some(c), _) => fuzz_one_case(&root, c, target),
-                (_, Some(p)) => fuzz_one_file(&p, target),
+                (_, Some(p)) => fuzz_one_file(&root, &p, target),
                 _ => fuzz(&root, &o),
             }
         }
@@ -262,6 +262,7 @@ fn fuzz(root: &std::path::Path, a: &FuzzArgs) -> Result<(), String> {
             out_dir: a.out.clone(),
             target: *t,
             limits: fuzz::Limits::default(),
+            base_dir: fuzz::base_dir(root),
         };
         let r = fuzz::fuzz(corpus.clone(), &o);
         println!("target {t:?}, {}", r.summary());
@@ -305,7 +306,8 @@ fn fuzz_one_case(root: &std::path::Path, seed: u64, t: FuzzTarget) -> Result<(),
             case.mutations.join("\n  "),
             case.text
         );
-        match fuzz::run_text(&case.text, t, &fuzz::Limits::default(), seed) {
+        let dir = fuzz::base_dir(root);
+        match fuzz::run_text(&case.text, t, &fuzz::Limits::default(), &dir, seed) {
             Ok(o) => println!("target {t:?}: {o:?}"),
             Err(m) => return Err(format!("target {t:?} panicked: {m}")),
         }
@@ -313,7 +315,11 @@ fn fuzz_one_case(root: &std::path::Path, seed: u64, t: FuzzTarget) -> Result<(),
     Ok(())
 }
 
-fn fuzz_one_file(path: &std::path::Path, t: FuzzTarget) -> Result<(), String> {
+fn fuzz_one_file(
+    root: &std::path::Path,
+    path: &std::path::Path,
+    t: FuzzTarget,
+) -> Result<(), String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     // the seed of the perturbed evaluation, from the header a failure has
     let seed = text
@@ -321,12 +327,10 @@ fn fuzz_one_file(path: &std::path::Path, t: FuzzTarget) -> Result<(), String> {
         .find_map(|l| l.split_once(" --case ").map(|(_, s)| s.trim().to_string()))
         .and_then(|s| parse_seed(&s).ok())
         .unwrap_or(0);
-    run_one(&text, seed, t)
-}
-
-fn run_one(text: &str, seed: u64, t: FuzzTarget) -> Result<(), String> {
+    // superelement files as in a run: from fixtures/fuzz
+    let dir = fuzz::base_dir(root);
     for t in targets(t) {
-        match fuzz::run_text(text, t, &fuzz::Limits::default(), seed) {
+        match fuzz::run_text(&text, t, &fuzz::Limits::default(), &dir, seed) {
             Ok(o) => println!("target {t:?}: {o:?}"),
             Err(m) => return Err(format!("target {t:?} panicked: {m}")),
         }

@@ -23,6 +23,7 @@ fn options(seed: u64, cases: u64, target: Target, dir: &str) -> Options {
         out_dir: temp_dir(dir),
         target,
         limits: Limits::default(),
+        base_dir: harness::base_dir(&xtask::workspace_root()),
     }
 }
 
@@ -33,7 +34,7 @@ fn options(seed: u64, cases: u64, target: Target, dir: &str) -> Options {
 fn a_short_fuzz_run_of_fixed_seed_finds_no_panic_and_no_hang() {
     let root = xtask::workspace_root();
     let c = corpus(&root).unwrap();
-    assert!(c.len() >= 13, "fixtures/scenes and fixtures/fuzz");
+    assert!(c.len() >= 14, "fixtures/scenes and fixtures/fuzz");
     for (target, seed) in [(Target::Parse, 14), (Target::Dynamics, 15)] {
         let o = options(seed, 300, target, &format!("{target:?}"));
         let r = harness::fuzz(c.clone(), &o);
@@ -133,7 +134,7 @@ fn every_seed_scene_survives_writing_back() {
         let a = flexmb_model::Scene::from_ron_str(&s.text).unwrap();
         let b = flexmb_model::Scene::from_ron_str(&a.to_ron()).unwrap();
         assert_eq!(a, b, "{}", s.name);
-        let m = a.build(None);
+        let m = a.build(Some(&harness::base_dir(&root)));
         assert!(m.is_ok(), "{}: {:?}", s.name, m.err());
     }
 }
@@ -155,7 +156,8 @@ fn huge_chains_are_skipped_or_refused_at_once() {
         )
     };
     let l = Limits::default();
-    let run = |n: &str| harness::run_text(&scene(n), Target::Dynamics, &l, 0).unwrap();
+    let dir = harness::base_dir(&xtask::workspace_root());
+    let run = |n: &str| harness::run_text(&scene(n), Target::Dynamics, &l, &dir, 0).unwrap();
     assert_eq!(run("3"), Outcome::EomOk);
     assert_eq!(run("251"), Outcome::TooLarge);
     assert_eq!(run("300000"), Outcome::TooLarge);

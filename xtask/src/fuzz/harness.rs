@@ -4,7 +4,8 @@
 //! Target 1 ([`parse_and_validate`]): `Scene::from_ron_str`, then
 //! `Scene::build`; either may fail, neither may panic or hang. Target 2
 //! ([`with_dynamics`]) then also prepares `Dynamics` and evaluates q̈ at
-//! t = 0 from q0 with q̇ = `initial_qd` (zeros when that fails), and once
+//! t = 0 from q0 with q̇ = `initial_qd` (finite or an error; zeros when it
+//! fails), and once
 //! more at a configuration and velocity perturbed by the case's seed: each
 //! call returns finite accelerations or an error (the energies at t = 0 as
 //! well: finite or an error).
@@ -127,15 +128,15 @@ fn chain_n(k: &ElementSpec) -> usize {
     }
 }
 
-/// Target 1: parse and validate.
-pub fn parse_and_validate(text: &str, l: &Limits) -> Outcome {
+/// Target 1: parse and validate; `base_dir` resolves superelement files.
+pub fn parse_and_validate(text: &str, l: &Limits, base_dir: Option<&Path>) -> Outcome {
     let Ok(scene) = Scene::from_ron_str(text) else {
         return Outcome::ParseError;
     };
     if !within(&scene, l) {
         return Outcome::TooLarge;
     }
-    match scene.build(None) {
+    match scene.build(base_dir) {
         Ok(_) => Outcome::Built,
         Err(_) => Outcome::BuildError,
     }
@@ -145,14 +146,14 @@ pub fn parse_and_validate(text: &str, l: &Limits) -> Outcome {
 /// q̇ from the scene's initial velocities, and at a configuration and
 /// velocity perturbed by `seed`; the energies at t = 0 too. Panics if an
 /// evaluation returns Ok with a non-finite value.
-pub fn with_dynamics(text: &str, l: &Limits, seed: u64) -> Outcome {
+pub fn with_dynamics(text: &str, l: &Limits, base_dir: Option<&Path>, seed: u64) -> Outcome {
     let Ok(scene) = Scene::from_ron_str(text) else {
         return Outcome::ParseError;
     };
     if !within(&scene, l) {
         return Outcome::TooLarge;
     }
-    let mech = match scene.build(None) {
+    let mech = match scene.build(base_dir) {
         Ok(m) => m,
         Err(_) => return Outcome::BuildError,
     };
@@ -162,7 +163,15 @@ pub fn with_dynamics(text: &str, l: &Limits, seed: u64) -> Outcome {
     }
     let q0 = mech.q0();
     let mut dy = Dynamics::new(Arc::new(mech));
-    let qd0 = dy.initial_qd(0.0, &q0).unwrap_or_else(|_| vec![0.0; n]);
+    let qd0 = match dy.initial_qd(0.0, &q0) {
+        Ok(v) => {
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                panic!("initial_qd returned Ok with q̇[{i}] = {}", v[i]);
+            }
+            v
+        }
+        Err(_) => vec![0.0; n],
+    };
     let mut qdd = vec![0.0; n];
     if dy.accelerations(0.0, &q0, &qd0, &mut qdd).is_err() {
         return Outcome::EomError;
@@ -211,6 +220,13 @@ pub struct Options {
     pub target: Target,
     /// Model size limits.
     pub limits: Limits,
+    /// The directory superelement files are resolved in ([`base_dir`]).
+    pub base_dir: PathBuf,
+}
+
+/// Where the superelement files of the seed scenes are: `fixtures/fuzz/`.
+pub fn base_dir(root: &Path) -> PathBuf {
+    root.join("fixtures/fuzz")
 }
 
 /// Why a case failed.
@@ -363,10 +379,16 @@ pub fn write_failure(dir: &Path, target: Target, case: &Case, problem: &Problem)
 }
 
 /// Runs one text through a target, catching a panic.
-pub fn run_text(text: &str, target: Target, l: &Limits, seed: u64) -> Result<Outcome, String> {
+pub fn run_text(
+    text: &str,
+    target: Target,
+    l: &Limits,
+    base_dir: &Path,
+    seed: u64,
+) -> Result<Outcome, String> {
     catching(|| match target {
-        Target::Parse => parse_and_validate(text, l),
-        Target::Dynamics => with_dynamics(text, l, seed),
+        Target::Parse => parse_and_validate(text, l, Some(base_dir)),
+        Target::Dynamics => with_dynamics(text, l, Some(base_dir), seed),
     })
 }
 
@@ -466,8 +488,8 @@ where
 
 /// A fuzz run of the real targets.
 pub fn fuzz(corpus: Vec<SeedScene>, o: &Options) -> Report {
-    let (target, limits) = (o.target, o.limits);
+    let (target, limits, dir) = (o.target, o.limits, o.base_dir.clone());
     drive(Arc::new(corpus), o, move |case| {
-        run_text(&case.text, target, &limits, case.seed)
+        run_text(&case.text, target, &limits, &dir, case.seed)
     })
 }

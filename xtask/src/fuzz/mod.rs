@@ -92,9 +92,13 @@ pub fn corpus(root: &Path) -> Result<Vec<SeedScene>, String> {
     for dir in ["fixtures/scenes", "fixtures/fuzz"] {
         let d = root.join(dir);
         let rd = std::fs::read_dir(&d).map_err(|e| format!("{}: {e}", d.display()))?;
+        // scenes only: not the superelement files (`*.se.ron`) they use
         let mut files: Vec<_> = rd
             .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+            .filter(|p| {
+                let n = p.file_name().unwrap_or_default().to_string_lossy();
+                n.ends_with(".ron") && !n.ends_with(".se.ron")
+            })
             .collect();
         files.sort();
         for p in files {

@@ -442,6 +442,27 @@ fn mutate_section(sec: &mut SectionSpec, rng: &mut Rng) {
     }
 }
 
+/// The superelement file of `fixtures/fuzz/`, or one that does not exist.
+fn superelement_file(rng: &mut Rng) -> String {
+    rng.pick(&[
+        "bar.se.ron",
+        "bar.se.ron",
+        "no-such-superelement.se.ron",
+        "",
+    ])
+    .to_string()
+}
+
+/// Mode groups to share (the bar of `fixtures/fuzz/` has only normal modes).
+fn share(rng: &mut Rng) -> (Option<String>, Option<String>) {
+    let mut one = || match rng.below(3) {
+        0 => None,
+        1 => Some("w".to_string()),
+        _ => Some("se1".to_string()),
+    };
+    (one(), one())
+}
+
 fn pair(s: &Scene, rng: &mut Rng) -> (String, String) {
     (node_id(s, rng), node_id(s, rng))
 }
@@ -508,9 +529,9 @@ fn new_element(s: &Scene, rng: &mut Rng) -> ElementSpec {
         },
         _ => ElementSpec::Superelement {
             nodes: pair(s, rng),
-            file: "no-such-superelement.ron".into(),
+            file: superelement_file(rng),
             transform: VelocityTransform::B3,
-            share: (None, None),
+            share: share(rng),
         },
     }
 }
@@ -666,10 +687,33 @@ fn mutate_element(s: &Scene, e: &mut ElementEntry, rng: &mut Rng) -> String {
                 format!("node {node:?}")
             }
         },
-        ElementSpec::Superelement { nodes, .. } => {
-            *nodes = pair(s, rng);
-            format!("nodes {nodes:?}")
-        }
+        ElementSpec::Superelement {
+            nodes,
+            file,
+            transform,
+            share: sh,
+        } => match rng.below(4) {
+            0 => {
+                *file = superelement_file(rng);
+                format!("file {file:?}")
+            }
+            1 => {
+                *sh = share(rng);
+                format!("share {sh:?}")
+            }
+            2 => {
+                *transform = *rng.pick(&[
+                    VelocityTransform::B1,
+                    VelocityTransform::B2,
+                    VelocityTransform::B3,
+                ]);
+                format!("transform {transform:?}")
+            }
+            _ => {
+                *nodes = pair(s, rng);
+                format!("nodes {nodes:?}")
+            }
+        },
     }
 }
 
