@@ -1,12 +1,14 @@
 //! `cargo xtask`: regenerates the thesis benchmarks (chapters 5 and 6) with
 //! the thesis's numbers side by side, speed against error, and the CI
-//! regression of stored eigenfrequency curves. See README.md and
-//! docs/reproduce.md.
+//! regression of stored eigenfrequency curves, and fuzzes the scene parser,
+//! validator and equations of motion (`cargo xtask fuzz`). See README.md,
+//! docs/reproduce.md and docs/cli.md.
 #![warn(missing_docs)]
 
 pub mod ch5;
 pub mod ch6;
 pub mod curves;
+pub mod fuzz;
 pub mod models;
 pub mod progress;
 pub mod regress;

@@ -1,14 +1,15 @@
-//! `cargo xtask reproduce ch5|ch6|all` and `cargo xtask regress`.
+//! `cargo xtask reproduce ch5|ch6|all`, `cargo xtask regress` and `cargo xtask fuzz`.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use xtask::fuzz::harness as fuzz;
 use xtask::progress::Progress;
 
 #[derive(Parser)]
 #[command(
     name = "cargo xtask",
-    about = "Regenerate the thesis benchmarks (chapters 5 and 6) and check the stored eigenfrequency curves"
+    about = "Regenerate the thesis benchmarks (chapters 5 and 6), check the stored eigenfrequency curves, fuzz the scene input"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -20,6 +21,16 @@ enum Chapter {
     Ch5,
     Ch6,
     All,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum FuzzTarget {
+    /// Parser and validator (`Scene::from_ron_str`, `Scene::build`).
+    Parse,
+    /// Also `Dynamics::new` and q̈ from `accelerations`.
+    Dynamics,
+    /// Half the time each.
+    Both,
 }
 
 #[derive(Subcommand)]
@@ -38,6 +49,43 @@ enum Cmd {
         #[arg(long)]
         update: bool,
     },
+    /// Fuzz the scene parser, the validator and one evaluation of the
+    /// equations of motion with mutated fixture scenes, for a bounded time.
+    /// A panic or hang is written to OUT/{panic,hang}-SEED.ron (exit code 1).
+    Fuzz {
+        /// Run for this long (seconds).
+        #[arg(long, default_value_t = 60.0)]
+        seconds: f64,
+        /// The run's seed (decimal or 0x hex); default from the clock.
+        #[arg(long, value_parser = parse_seed)]
+        seed: Option<u64>,
+        /// Stop after this many cases per target.
+        #[arg(long)]
+        cases: Option<u64>,
+        /// parse, dynamics or both.
+        #[arg(long, value_enum, default_value = "both")]
+        target: FuzzTarget,
+        /// A case without a result after this many seconds is a hang.
+        #[arg(long, default_value_t = 10.0)]
+        case_timeout: f64,
+        /// Run only the case of this seed (as printed for a failure), printing it.
+        #[arg(long, value_parser = parse_seed, conflicts_with = "input")]
+        case: Option<u64>,
+        /// Run only this scene file (e.g. a written failure).
+        #[arg(long)]
+        input: Option<PathBuf>,
+        /// Where failing inputs are written (default: the target directory's fuzz/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+fn parse_seed(s: &str) -> Result<u64, String> {
+    let r = match s.strip_prefix("0x") {
+        Some(h) => u64::from_str_radix(h, 16),
+        None => s.parse(),
+    };
+    r.map_err(|e| format!("{s}: {e}"))
 }
 
 fn main() -> ExitCode {
@@ -54,6 +102,36 @@ fn main() -> ExitCode {
             reproduce(&root, &out, chapter, &pg)
         }
         Cmd::Regress { update } => regress(&root, update, &pg),
+        Cmd::Fuzz {
+            seconds,
+            seed,
+            cases,
+            target,
+            case_timeout,
+            case,
+            input,
+            out,
+        } => {
+            let out = out.unwrap_or_else(|| {
+                std::env::var_os("CARGO_TARGET_DIR")
+                    .map(PathBuf::from)
+                    .unwrap_or_else(|| root.join("target"))
+                    .join("fuzz")
+            });
+            let o = FuzzArgs {
+                seconds,
+                seed,
+                cases,
+                target,
+                case_timeout,
+                out,
+            };
+            match (case, input) {
+                (Some(c), _) => fuzz_one_case(&root, c, target),
+                (_, Some(p)) => fuzz_one_file(&root, &p, target),
+                _ => fuzz(&root, &o),
+            }
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -127,4 +205,135 @@ fn regress(root: &std::path::Path, update: bool, pg: &Progress) -> Result<(), St
             diffs.len()
         ))
     }
+}
+
+struct FuzzArgs {
+    seconds: f64,
+    seed: Option<u64>,
+    cases: Option<u64>,
+    target: FuzzTarget,
+    case_timeout: f64,
+    out: PathBuf,
+}
+
+fn targets(t: FuzzTarget) -> Vec<fuzz::Target> {
+    match t {
+        FuzzTarget::Parse => vec![fuzz::Target::Parse],
+        FuzzTarget::Dynamics => vec![fuzz::Target::Dynamics],
+        FuzzTarget::Both => vec![fuzz::Target::Parse, fuzz::Target::Dynamics],
+    }
+}
+
+fn fuzz(root: &std::path::Path, a: &FuzzArgs) -> Result<(), String> {
+    if !(a.seconds.is_finite() && a.seconds >= 0.0) {
+        return Err(format!(
+            "--seconds {} must be a non-negative number",
+            a.seconds
+        ));
+    }
+    if !(a.case_timeout.is_finite() && a.case_timeout > 0.0) {
+        return Err(format!(
+            "--case-timeout {} must be positive",
+            a.case_timeout
+        ));
+    }
+    let corpus = xtask::fuzz::corpus(root)?;
+    let seed = a.seed.unwrap_or_else(|| {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() as u64)
+            .unwrap_or(1)
+    });
+    let ts = targets(a.target);
+    println!(
+        "fuzzing {} scenes, seed {seed:#018x}, {:.0} s; failures and an aborted case go to {}",
+        corpus.len(),
+        a.seconds,
+        a.out.display()
+    );
+    let mut failed = 0;
+    for (i, t) in ts.iter().enumerate() {
+        let o = fuzz::Options {
+            // a different stream of cases for each target
+            seed: seed.wrapping_add(i as u64),
+            duration: std::time::Duration::from_secs_f64(a.seconds / ts.len() as f64),
+            max_cases: a.cases,
+            case_timeout: std::time::Duration::from_secs_f64(a.case_timeout),
+            out_dir: a.out.clone(),
+            target: *t,
+            limits: fuzz::Limits::default(),
+            base_dir: fuzz::base_dir(root),
+        };
+        let r = fuzz::fuzz(corpus.clone(), &o);
+        println!("target {t:?}, {}", r.summary());
+        for f in &r.failures {
+            eprintln!(
+                "\ncase {:#018x} from {}, mutations:\n  {}\n{}\n--- input:\n{}\n---",
+                f.case.seed,
+                f.case.source,
+                f.case.mutations.join("\n  "),
+                match &f.problem {
+                    fuzz::Problem::Panic(m) => m.clone(),
+                    fuzz::Problem::Hang(d) => format!("no result after {:.1} s", d.as_secs_f64()),
+                },
+                f.case.text
+            );
+            if matches!(f.problem, fuzz::Problem::Hang(_)) {
+                // the case is still running on its thread: stop here
+                eprintln!("error: a hang; its input is in {}", f.file.display());
+                std::process::exit(1);
+            }
+        }
+        failed += r.failures.len();
+    }
+    if failed > 0 {
+        return Err(format!(
+            "{failed} failing case(s); inputs in {}",
+            a.out.display()
+        ));
+    }
+    Ok(())
+}
+
+fn fuzz_one_case(root: &std::path::Path, seed: u64, t: FuzzTarget) -> Result<(), String> {
+    let corpus = xtask::fuzz::corpus(root)?;
+    for t in targets(t) {
+        // each target makes its own case from the seed
+        let case = xtask::fuzz::generate(&corpus, seed, t.structural_share());
+        println!(
+            "target {t:?}: case {seed:#018x} from {}, mutations:\n  {}\n--- input:\n{}\n---",
+            case.source,
+            case.mutations.join("\n  "),
+            case.text
+        );
+        let dir = fuzz::base_dir(root);
+        match fuzz::run_text(&case.text, t, &fuzz::Limits::default(), &dir, seed) {
+            Ok(o) => println!("target {t:?}: {o:?}"),
+            Err(m) => return Err(format!("target {t:?} panicked: {m}")),
+        }
+    }
+    Ok(())
+}
+
+fn fuzz_one_file(
+    root: &std::path::Path,
+    path: &std::path::Path,
+    t: FuzzTarget,
+) -> Result<(), String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    // the seed of the perturbed evaluation, from the header a failure has
+    let seed = text
+        .lines()
+        .find_map(|l| l.split_once(" --case ").map(|(_, s)| s.trim().to_string()))
+        .and_then(|s| parse_seed(&s).ok())
+        .unwrap_or(0);
+    // superelement files as in a run: from fixtures/fuzz
+    let dir = fuzz::base_dir(root);
+    for t in targets(t) {
+        match fuzz::run_text(&text, t, &fuzz::Limits::default(), &dir, seed) {
+            Ok(o) => println!("target {t:?}: {o:?}"),
+            Err(m) => return Err(format!("target {t:?} panicked: {m}")),
+        }
+    }
+    Ok(())
 }

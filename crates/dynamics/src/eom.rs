@@ -501,7 +501,7 @@ impl Dynamics {
             return self.accelerations_by_projection(t, q, qd, qdd);
         }
         if let Some(i) = qdd[..n].iter().position(|v| !v.is_finite()) {
-            return Err(self.non_finite("q̈", &qdd[..n], i, t));
+            return Err(self.non_finite_result("q̈", &qdd[..n], i, t));
         }
         Ok(())
     }
@@ -571,7 +571,7 @@ impl Dynamics {
             MemStack::new(&mut self.llt_mem),
         );
         if let Some(i) = qdd.iter().position(|v| !v.is_finite()) {
-            return Err(self.non_finite("q̈", qdd, i, t));
+            return Err(self.non_finite_result("q̈", qdd, i, t));
         }
         Ok(())
     }
@@ -640,6 +640,59 @@ impl Dynamics {
         }
     }
 
+    /// The error for a non-finite result `what` (q̈, an initial q̇): the
+    /// prescribed input, load or controller reference whose time function is
+    /// not finite at t when there is one (the cause), else the DOFs.
+    pub(crate) fn non_finite_result(
+        &self,
+        what: &'static str,
+        values: &[f64],
+        index: usize,
+        t: f64,
+    ) -> DynamicsError {
+        let mech = &self.mech;
+        let bad = |f: &flexmb_model::TimeFunction| {
+            let (v, d, dd) = f.eval(t);
+            (!(v.is_finite() && d.is_finite() && dd.is_finite()))
+                .then(|| format!("its function gives value {v}, rate {d}, acceleration {dd}"))
+        };
+        let inputs = mech.inputs.iter().enumerate().filter_map(|(k, u)| {
+            bad(&u.function).map(|m| {
+                let name = format!("{} ({m})", mech.coordinate_name(u.target));
+                ("prescribed input", k, name)
+            })
+        });
+        let loads = mech.loads.iter().enumerate().filter_map(|(k, l)| {
+            let (f, i) = match l {
+                Load::Force {
+                    function, index, ..
+                } => (function, index[0]),
+                Load::PlanarMoment {
+                    function, index, ..
+                } => (function, *index),
+                Load::SpatialMoment {
+                    function, index, ..
+                } => (function, index[0]),
+            };
+            bad(f).map(|m| ("load", k, format!("{k} on {} ({m})", mech.x_names[i])))
+        });
+        let controllers = mech.controllers.iter().enumerate().filter_map(|(k, c)| {
+            bad(&c.reference).map(|m| {
+                let name = format!("the controller on {} ({m})", mech.coordinate_name(c.on));
+                ("controller reference", k, name)
+            })
+        });
+        match inputs.chain(loads).chain(controllers).next() {
+            Some((what, index, name)) => DynamicsError::NonFinite {
+                what,
+                index,
+                name,
+                t,
+            },
+            None => self.non_finite(what, values, index, t),
+        }
+    }
+
     /// The residual g(q, q̇, q̈, t) = F,qᵀ(Mx ẍ − f) + E,qᵀσ of (E.1).
     pub fn residual(
         &mut self,
@@ -692,7 +745,9 @@ impl Dynamics {
         &self.mq
     }
 
-    /// Energies at (q, q̇, t).
+    /// Energies at (q, q̇, t); an error naming the element at which an
+    /// energy stops being finite (e.g. T = ½mv² overflowing for a velocity
+    /// of 1e200), not a non-finite value.
     pub fn energies(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Result<Energies, DynamicsError> {
         self.kinematics_at(t, q, Some(qd))?;
         let mech = self.mech.clone();
@@ -703,7 +758,7 @@ impl Dynamics {
         };
         let mut xl = [0.0; 64];
         let mut vl = [0.0; 64];
-        for e in &mech.elements {
+        for (index, e) in mech.elements.iter().enumerate() {
             let n = e.x_index.len();
             for (k, gi) in e.x_index.iter().enumerate() {
                 xl[k] = x[*gi];
@@ -726,12 +781,27 @@ impl Dynamics {
                     en.elastic += e.element.elastic_energy(&eps[o..o + ne]);
                 }
             }
+            let sums = [
+                ("kinetic energy", en.kinetic),
+                ("elastic energy", en.elastic),
+                ("gravitational potential", en.gravitational),
+            ];
+            if let Some((what, _)) = sums.iter().find(|(_, v)| !v.is_finite()) {
+                return Err(DynamicsError::NonFinite {
+                    what,
+                    index,
+                    name: format!("element '{}' (the sum up to it)", e.id),
+                    t,
+                });
+            }
         }
         Ok(en)
     }
 
     /// Initial q̇ from the scene's initial nodal velocities (rigid-body fields),
-    /// by least squares on F,q q̇ = ẋ0 − F,u u̇ at the configuration q0.
+    /// by least squares on F,q q̇ = ẋ0 − F,u u̇ at the configuration q0; an
+    /// error naming the cause (an input whose rate is not finite, else the
+    /// DOFs) when q̇ is not finite.
     pub fn initial_qd(&mut self, t: f64, q0: &[f64]) -> Result<Vec<f64>, DynamicsError> {
         let n_q = self.n_q();
         self.kinematics_at(t, q0, None)?;
@@ -765,7 +835,11 @@ impl Dynamics {
                 .map_err(|_| DynamicsError::Invalid("F,q is rank deficient".into()))?;
             llt.solve_in_place(b.as_mut());
         }
-        Ok((0..n_q).map(|i| b[(i, 0)]).collect())
+        let qd: Vec<f64> = (0..n_q).map(|i| b[(i, 0)]).collect();
+        if let Some(i) = qd.iter().position(|v| !v.is_finite()) {
+            return Err(self.non_finite_result("initial q̇", &qd, i, t));
+        }
+        Ok(qd)
     }
 
     /// Power of the external forces (loads, gravity, controllers) at (q, q̇, t):

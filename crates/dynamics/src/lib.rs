@@ -87,9 +87,10 @@ pub enum DynamicsError {
     NonFinite {
         /// Which quantity.
         what: &'static str,
-        /// Index.
+        /// Index (of the DOF, or of the element for an energy).
         index: usize,
-        /// What that entry is ([`flexmb_model::Mechanism::dof_label`]).
+        /// What that entry is ([`flexmb_model::Mechanism::dof_label`]), or
+        /// the element at which an energy stopped being finite.
         name: String,
         /// Time.
         t: f64,
