@@ -201,7 +201,11 @@ fn build(scene: &Scene, path: &Path) -> Result<flexmb_model::Mechanism, Failure>
     let spinner = report::spinner("building the mechanism and choosing its degrees of freedom");
     let mech = scene.build(path.parent());
     spinner.finish_and_clear();
-    mech.map_err(|e| Failure::Input(e.to_string()))
+    mech.map_err(|e| match e {
+        // a numerical failure on a valid scene, not bad input
+        flexmb_model::ModelError::Computation { .. } => Failure::Compute(e.to_string()),
+        _ => Failure::Input(e.to_string()),
+    })
 }
 
 /// A failed write.

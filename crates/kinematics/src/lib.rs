@@ -587,11 +587,10 @@ impl Kinematics {
     fn singular_error(&self) -> KinematicsError {
         // null space of J by SVD names the undetermined coordinates
         let mut names = vec![];
-        if let Ok(svd) = self.lu.to_dense().svd() {
-            let s = svd.S().column_vector();
-            let n = s.nrows();
+        if let Ok(svd) = flexmb_linalg::svd(self.lu.to_dense().as_ref()) {
+            let n = svd.s.len();
             if n > 0 {
-                let v = svd.V();
+                let v = &svd.v;
                 let j = n - 1;
                 let mx = (0..n).map(|i| v[(i, j)].abs()).fold(0.0f64, f64::max);
                 for i in 0..n {

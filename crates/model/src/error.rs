@@ -82,6 +82,15 @@ pub enum ModelError {
         /// Names of the coordinates taking part in them.
         undetermined: Vec<String>,
     },
+    /// A decomposition failed on finite input (a numerical failure, not a
+    /// modelling error).
+    #[error("{what}: {source}")]
+    Computation {
+        /// What was being decomposed.
+        what: String,
+        /// The linear-algebra error.
+        source: flexmb_linalg::SvdError,
+    },
     /// A dense matrix or a model too large for this machine.
     #[error("{what}, more than a quarter of this machine's memory ({limit}); make the model smaller (fewer chain elements `n`) or split it")]
     TooLarge {

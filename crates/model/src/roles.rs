@@ -251,26 +251,19 @@ fn check_dense_against(
 const RANK_TOL: f64 = 1e-9;
 
 /// Rank and null spaces of a (row-normalized) matrix: (rank, left null
-/// vectors as columns, right null space as columns).
-fn null_spaces(a: &Mat<f64>) -> (usize, Mat<f64>, Mat<f64>) {
+/// vectors as columns, right null space as columns), from the SVD of
+/// [`flexmb_linalg::svd`] (which falls back to other methods where faer's
+/// does not converge). `what` names the matrix in the error.
+fn null_spaces(a: &Mat<f64>, what: &str) -> Result<(usize, Mat<f64>, Mat<f64>), ModelError> {
     let (m, n) = (a.nrows(), a.ncols());
-    if m == 0 {
-        return (0, Mat::zeros(0, 0), Mat::identity(n, n));
-    }
-    if n == 0 {
-        return (0, Mat::identity(m, m), Mat::zeros(0, 0));
-    }
-    let svd = a.svd().expect("SVD converges");
-    let s = svd.S().column_vector();
-    let smax = (0..s.nrows()).map(|i| s[i]).fold(0.0f64, f64::max);
-    let r = (0..s.nrows())
-        .filter(|&i| s[i] > RANK_TOL * smax.max(1e-300))
-        .count();
-    let u = svd.U();
-    let v = svd.V();
-    let left = Mat::from_fn(m, m - r, |i, j| u[(i, r + j)]);
-    let right = Mat::from_fn(n, n - r, |i, j| v[(i, r + j)]);
-    (r, left, right)
+    let d = flexmb_linalg::svd(a.as_ref()).map_err(|source| ModelError::Computation {
+        what: format!("choosing the degrees of freedom: {what}"),
+        source,
+    })?;
+    let r = d.rank(RANK_TOL);
+    let left = Mat::from_fn(m, m - r, |i, j| d.u[(i, r + j)]);
+    let right = Mat::from_fn(n, n - r, |i, j| d.v[(i, r + j)]);
+    Ok((r, left, right))
 }
 
 fn names_in(vectors: &Mat<f64>, names: &[String]) -> Vec<String> {
@@ -461,7 +454,8 @@ impl<'p, 'a> Dense<'p, 'a> {
                 0.0
             }
         });
-        let (rank, left, null) = null_spaces(&c);
+        let (rank, left, null) =
+            null_spaces(&c, "the constraint Jacobian on the free coordinates")?;
         if rank < crow.len() {
             let names: Vec<String> = crow.iter().map(|j| p.mech.eps_names[*j].clone()).collect();
             return Err(ModelError::OverConstrained {
@@ -1225,7 +1219,10 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
             }
         }
     }
-    let (rank, left, right) = null_spaces(&jd);
+    let (rank, left, right) = null_spaces(
+        &jd,
+        "the Jacobian of the equations on the dependent coordinates",
+    )?;
     if rank < mech.dependent.len() {
         let rn: Vec<String> = mech
             .constraint_rows

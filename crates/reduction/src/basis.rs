@@ -185,15 +185,13 @@ fn svd_keep(n: usize, cols: &[Vec<f64>], threshold: f64) -> Result<KeptSingular,
         ));
     }
     let a = Mat::from_fn(n, cols.len(), |i, j| cols[j][i]);
-    let svd = a
-        .thin_svd()
-        .map_err(|_| ReductionError::Invalid("SVD did not converge".into()))?;
-    let s = svd.S().column_vector();
-    let singular_values: Vec<f64> = (0..s.nrows()).map(|i| s[i]).collect();
+    let svd = flexmb_linalg::thin_svd(a.as_ref())
+        .map_err(|e| ReductionError::Computation(format!("the SVD of the mode shapes: {e}")))?;
+    let singular_values = svd.s.clone();
     let sum: f64 = singular_values.iter().sum();
     let relative: Vec<f64> = singular_values.iter().map(|x| x / sum).collect();
     let keep = relative.iter().filter(|x| **x > threshold).count().max(1);
-    let u = svd.U();
+    let u = &svd.u;
     Ok(KeptSingular {
         u: Mat::from_fn(n, keep, |i, j| u[(i, j)]),
         singular_values,

@@ -82,6 +82,9 @@ pub enum ReductionError {
         /// The solver's last message.
         message: String,
     },
+    /// A decomposition failed on finite input (a numerical failure).
+    #[error("{0}")]
+    Computation(String),
     /// The reduced mass matrix is singular (dependent basis vectors).
     #[error("the reduced mass matrix is not positive definite: the basis vectors are linearly dependent or carry no inertia")]
     SingularMass,

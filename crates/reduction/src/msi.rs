@@ -88,9 +88,12 @@ pub fn mac_sorted(v: &[Mat<f64>]) -> Vec<Mat<f64>> {
 
 /// The largest principal angle (radians) between the column spaces of a and b
 /// (of equal dimension), from its sine ‖(I − QaQaᵀ)Qb‖₂ (accurate for small angles).
-pub fn largest_principal_angle(a: &Mat<f64>, b: &Mat<f64>) -> f64 {
+///
+/// An error when the spectral norm cannot be computed (non-finite input, or
+/// no SVD converged), never a silent 0.
+pub fn largest_principal_angle(a: &Mat<f64>, b: &Mat<f64>) -> Result<f64, flexmb_linalg::SvdError> {
     let (qa, qb) = (orthonormalize(a), orthonormalize(b));
     let r = &qb - &qa * (qa.transpose() * &qb);
-    let s = r.singular_values().unwrap_or_default();
-    s.iter().copied().fold(0.0f64, f64::max).min(1.0).asin()
+    let s = flexmb_linalg::singular_values(r.as_ref())?;
+    Ok(s.iter().copied().fold(0.0f64, f64::max).min(1.0).asin())
 }

@@ -199,7 +199,7 @@ fn path_eigenvectors_on_the_guidance() {
         );
     }
     let all = Mat::from_fn(n, 4, |i, j| if j == 0 { v1[i] } else { vpath[(i, j - 1)] });
-    let angle = largest_principal_angle(&all, &modes.vectors);
+    let angle = largest_principal_angle(&all, &modes.vectors).unwrap();
     assert!(
         angle < 1e-10,
         "span differs from modes 1–4 by {angle:e} rad"
@@ -252,6 +252,6 @@ fn unconstrained_path_eigenvectors_remove_the_path_direction() {
             all[(i, j + 1)] = v[(i, j)];
         }
     }
-    assert!(largest_principal_angle(&all, &vu) < 1e-10);
+    assert!(largest_principal_angle(&all, &vu).unwrap() < 1e-10);
     assert!(unconstrained_path_eigenvectors(&vu, &f_p, &[0.0, 0.0]).is_err());
 }
