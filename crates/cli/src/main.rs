@@ -750,7 +750,7 @@ fn build_superelement(spec_path: &Path) -> Result<(), Failure> {
             Failure::Compute(e.to_string())
         }
     })?;
-    say!("{:#?}", out.result.report);
+    say!("{}", out.result.summary(&spec.name).trim_end());
     for f in &out.written {
         say!("wrote {}", f.display());
     }

@@ -202,6 +202,63 @@ impl BuildResult {
         Ok(to_hz(&lam))
     }
 
+    /// A readable account of the build, for people (the command line prints
+    /// it): the part, its coordinates, the FE model, the rigid-body
+    /// properties of M̄, the frequencies and where the time went.
+    pub fn summary(&self, name: &str) -> String {
+        let r = &self.report;
+        let d = &self.data;
+        let (kp, kq, kf) = d.mode_counts();
+        let rb = RigidBodyProperties::from_m_bar(&d.m_bar_matrix(), d.l0);
+        let hz = |f: &[f64]| {
+            f.iter()
+                .map(|x| format!("{x:.4}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let mut out = format!(
+            "superelement '{name}': l0 = {:.6} m, {} coordinates (12 interface, {kp} + {kq} deformable-interface, \
+             {kf} fixed-interface normal modes); ε has {} components\n",
+            d.l0,
+            12 + d.n_modes(),
+            6 + d.n_modes()
+        );
+        out.push_str(&format!(
+            "FE model: {} equations, {} interior; interface p {} nodes, q {} nodes; interior stiffness factor {} \
+             entries\n",
+            r.n_eq, r.n_interior, r.interface_nodes[0], r.interface_nodes[1], r.factor_nnz
+        ));
+        out.push_str(&format!(
+            "rigid body (from M̄, element frame from p): mass {:.6e} kg (FE {:.6e} kg), centre of mass ({:.4e}, \
+             {:.4e}, {:.4e}) m, inertia diagonal about it ({:.4e}, {:.4e}, {:.4e}) kg m²\n",
+            rb.mass, r.fe_mass, rb.com[0], rb.com[1], rb.com[2], rb.inertia[0][0], rb.inertia[1][1], rb.inertia[2][2]
+        ));
+        if !r.normal_frequencies_hz.is_empty() {
+            out.push_str(&format!(
+                "fixed-interface normal modes: {} Hz\n",
+                hz(&r.normal_frequencies_hz)
+            ));
+        }
+        if let Ok(f) = self.clamped_free_frequencies() {
+            let n = f.len().min(6);
+            out.push_str(&format!(
+                "clamped at p, free at q: {} Hz (lowest {n})\n",
+                hz(&f[..n])
+            ));
+        }
+        out.push_str(
+            "checked before the reduction: K, M, the DOF list and the mesh against each other, every node attached to \
+             p or q, the density where the volume is known (docs/superelement.md)\n",
+        );
+        let t: Vec<String> = r
+            .timings
+            .iter()
+            .map(|(k, v)| format!("{k} {v:.3} s"))
+            .collect();
+        out.push_str(&format!("time: {}\n", t.join(", ")));
+        out
+    }
+
     /// Clamped-free eigenfrequencies (Hz): µ̄p fixed, interface modes fixed
     /// (rigid interfaces), µ̄q and the normal modes free.
     pub fn clamped_free_frequencies(&self) -> Result<Vec<f64>, Error> {
@@ -735,14 +792,43 @@ impl<'a> Ctx<'a> {
             if !(rho >= lo && rho <= hi) {
                 return Err(Error::Units(format!(
                     "model {}: the total mass {mass:.4e} kg over the mesh volume {v:.4e} m³ implies a density of \
-                     {rho:.4e} kg/m³, outside {lo}..{hi}; are the coordinates in mm while the matrices are in SI (or \
-                     the reverse)?",
-                    model.name
+                     {rho:.4e} kg/m³, outside {lo}..{hi}{}",
+                    model.name,
+                    units_advice(rho)
                 )));
             }
         }
         Ok(mass)
     }
+}
+
+/// What to set in a spec when the FE mass over the mesh volume gives the
+/// implausible density `rho` (kg/m³): the unit system whose conversion
+/// brings a steel-to-foam density back, or a mass scale.
+fn units_advice(rho: f64) -> String {
+    // a system fits if its density factor mass/length³ brings rho into the
+    // range of real solids (foams to tungsten)
+    let fits: Vec<&str> = crate::units::UNIT_SYSTEMS
+        .iter()
+        .filter(|u| u.name != "SI")
+        .filter(|u| {
+            let r = rho * u.mass / u.length.powi(3);
+            (10.0..=30000.0).contains(&r)
+        })
+        .map(|u| u.name)
+        .collect();
+    let systems = if fits.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " set `units: Some(\"{}\")` in the spec if the files are in those units, or",
+            fits.join("\" or \"")
+        )
+    };
+    format!(
+        "; the FE files carry no units:{systems} set `mass_scale:` (and `stiffness_scale:`) to convert them to SI; \
+         are the coordinates in mm while the matrices are in SI (or the reverse)?"
+    )
 }
 
 /// Rows of the rigid map u = R0 ū + (R0 φ̄) × d over (ū, φ̄) (element frame).

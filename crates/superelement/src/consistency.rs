@@ -465,7 +465,10 @@ fn element_mass_moments(model: &FeModel, c: [f64; 3]) -> Option<Moments> {
 fn units_hint(ratio: f64) -> String {
     let k = (ratio.log10() / 3.0).round();
     if k != 0.0 && (ratio.log10() - 3.0 * k).abs() < 0.5 {
-        format!(" (a factor {ratio:.3e}: are the units consistent, m and kg?)")
+        format!(
+            " (a factor {ratio:.3e}: are the units consistent, m and kg? Files in other units are converted by the \
+             spec's `units:` (\"mm-t-s\", \"mm-kg-ms\", \"mm-kg-s\") or `mass_scale:`)"
+        )
     } else {
         String::new()
     }
@@ -483,12 +486,19 @@ pub struct RigidBodyComparison {
     /// the bounding-box diagonal), inertia entries (of the largest diagonal
     /// entry of the mesh's inertia).
     pub difference: [f64; 3],
+    /// M is diagonal (a lumped mass, as ANSYS and Abaqus write for many
+    /// element types). Lumping keeps the mass and the centre of mass exact but
+    /// moves the inertia by O(h²) (the rotor of `fixtures/fe-exports`: 10 %),
+    /// so the inertia difference is reported but not checked.
+    pub lumped: bool,
 }
 
 impl RigidBodyComparison {
-    /// The largest of the three relative differences.
+    /// The largest of the relative differences that are checked (the inertia
+    /// only for a consistent mass).
     pub fn worst(&self) -> f64 {
-        self.difference.iter().copied().fold(0.0, f64::max)
+        let n = if self.lumped { 2 } else { 3 };
+        self.difference[..n].iter().copied().fold(0.0, f64::max)
     }
 }
 
@@ -497,6 +507,14 @@ impl RigidBodyComparison {
 /// has a density.
 pub(crate) fn compare_rigid_body(model: &FeModel) -> Option<RigidBodyComparison> {
     compare_with(model, &RigidFields::of(model))
+}
+
+/// True if every stored entry of `a` is on its diagonal.
+fn is_diagonal(a: faer::sparse::SparseColMatRef<'_, usize, f64>) -> bool {
+    (0..a.ncols()).all(|j| {
+        a.col_range(j)
+            .all(|p| a.symbolic().row_idx()[p] == j || a.val()[p] == 0.0)
+    })
 }
 
 /// [`compare_rigid_body`] with the rigid fields already multiplied by M.
@@ -527,6 +545,7 @@ fn compare_with(model: &FeModel, fields: &RigidFields) -> Option<RigidBodyCompar
             inertia,
         },
         difference: [d_mass, d_com, d_j],
+        lumped: is_diagonal(model.m()),
     })
 }
 

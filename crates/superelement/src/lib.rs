@@ -20,6 +20,10 @@
 //!   [`consistency`]: the checks of K, M, the DOF list and the mesh against
 //!   each other that [`build`] runs first; [`geometry`]: volume moments of
 //!   solid elements for its rigid-body check.
+//! * [`abaqus`] (`*MATRIX OUTPUT` in all three formats with the `.inp`
+//!   deck) and [`ansys`] (APDL Math MMF or `HBMAT` [`harwell_boeing`] with
+//!   the DOF mapping and nodal coordinates): the exports of the commercial
+//!   packages, with [`units`] for exports not in SI;
 //! * [`spec`]: a RON specification and [`build_from_spec`], the function behind
 //!   `flexmb build-superelement SPEC.ron`.
 //!
@@ -43,10 +47,13 @@
 // deliberate: they also reject NaN.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod abaqus;
+pub mod ansys;
 mod builder;
 pub mod consistency;
 mod error;
 pub mod geometry;
+pub mod harwell_boeing;
 pub mod linalg;
 mod model;
 pub mod parts;
@@ -54,6 +61,8 @@ pub mod readers;
 mod reduction;
 pub mod solid;
 pub mod spec;
+mod symmetric;
+pub mod units;
 
 pub use builder::{
     build, compatible_interface_pattern, fixed_interface_eigenvalues_dense,

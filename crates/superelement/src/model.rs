@@ -239,6 +239,42 @@ impl FeModel {
         })
     }
 
+    /// Converts a model read in other units to SI: coordinates × `length`
+    /// (m per file unit), K × `stiffness` (N/m per file unit), M × `mass` (kg
+    /// per file unit); the volume and the element densities follow. Every
+    /// factor must be positive and finite.
+    pub fn rescale(&mut self, length: f64, stiffness: f64, mass: f64) -> Result<(), Error> {
+        for (what, f) in [("length", length), ("stiffness", stiffness), ("mass", mass)] {
+            if !(f > 0.0 && f.is_finite()) {
+                return Err(Error::Spec(format!(
+                    "model {}: a {what} scale of {f} (it must be positive and finite)",
+                    self.name
+                )));
+            }
+        }
+        for c in &mut self.coords {
+            for x in c.iter_mut() {
+                *x *= length;
+            }
+        }
+        for v in self.k.val_mut() {
+            *v *= stiffness;
+        }
+        for v in self.m.val_mut() {
+            *v *= mass;
+        }
+        let l3 = length.powi(3);
+        if let Some(v) = &mut self.volume {
+            *v *= l3;
+        }
+        if let Some(solid) = &mut self.solid {
+            for rho in solid.density.iter_mut().flatten() {
+                *rho *= mass / l3;
+            }
+        }
+        Ok(())
+    }
+
     /// Number of nodes.
     pub fn n_nodes(&self) -> usize {
         self.coords.len()

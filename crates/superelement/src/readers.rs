@@ -18,11 +18,11 @@ use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-fn read(path: &Path) -> Result<String, Error> {
+pub(crate) fn read(path: &Path) -> Result<String, Error> {
     std::fs::read_to_string(path).map_err(|e| Error::io(path, e))
 }
 
-fn fname(path: &Path) -> String {
+pub(crate) fn fname(path: &Path) -> String {
     path.display().to_string()
 }
 
@@ -151,7 +151,7 @@ pub fn parse_matrix_market(text: &str, file: &str) -> Result<SparseColMat<usize,
 
 /// One `row col value` line (1-based indices, not yet range-checked), as
 /// Matrix Market coordinate entries and CalculiX `.sti`/`.mas` files hold them.
-fn parse_triplet(
+pub(crate) fn parse_triplet(
     f: &[&str],
     line: &str,
     file: &str,
@@ -175,14 +175,14 @@ fn parse_triplet(
     Ok((i, j, v))
 }
 
-fn parse_f64(s: &str) -> Option<f64> {
+pub(crate) fn parse_f64(s: &str) -> Option<f64> {
     // Fortran-style exponents (1.0D+03) appear in some exports
     s.parse::<f64>()
         .ok()
         .or_else(|| s.replace(['D', 'd'], "e").parse().ok())
 }
 
-fn to_csc(
+pub(crate) fn to_csc(
     nr: usize,
     nc: usize,
     trip: Vec<(usize, usize, f64)>,
@@ -231,6 +231,9 @@ pub fn write_matrix_market_dense(path: &Path, a: &nalgebra::DMatrix<f64>) -> Res
 }
 
 pub(crate) fn write_file(path: &Path, s: &str) -> Result<(), Error> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))?;
+    }
     let mut f = std::fs::File::create(path).map_err(|e| Error::write(path, e))?;
     f.write_all(s.as_bytes()).map_err(|e| Error::write(path, e))
 }
@@ -308,7 +311,7 @@ fn cut_off_or(text: &str, file: &str, e: Error) -> Error {
 /// Errors if `text` does not end with an end of line: every line CalculiX
 /// and Matrix Market writers write ends with one, and a value cut short can
 /// still be read as a number (`1.2345678901234e+07` → `1.2345678901234e+0`).
-fn check_not_cut_off(text: &str, file: &str) -> Result<(), Error> {
+pub(crate) fn check_not_cut_off(text: &str, file: &str) -> Result<(), Error> {
     if text.is_empty() || text.ends_with('\n') {
         return Ok(());
     }
@@ -662,6 +665,9 @@ enum Block {
     Elset(String, bool),
     /// *DENSITY of the named material.
     Density(String),
+    /// The positioning data lines of an Abaqus *INSTANCE (translation, then
+    /// rotation): the instance's name.
+    InstanceData(String),
 }
 
 /// Keywords that couple nodes outside the elements (the mass then couples
@@ -688,6 +694,14 @@ struct InpParser {
     material: Option<String>,
     /// Element sets named inside other element sets: (set, member set).
     elset_refs: Vec<(String, String)>,
+    /// The open Abaqus *PART or *INSTANCE (upper-case name), if any.
+    part: Option<String>,
+    instance: Option<String>,
+    /// Parts and instances that define nodes, and every instance with its
+    /// part: (instance, part, where).
+    parts_with_nodes: Vec<String>,
+    instances_with_nodes: Vec<String>,
+    instances: Vec<(String, String, String)>,
 }
 
 impl InpParser {
@@ -699,6 +713,11 @@ impl InpParser {
             pending_at: (String::new(), 0),
             material: None,
             elset_refs: Vec::new(),
+            part: None,
+            instance: None,
+            parts_with_nodes: Vec::new(),
+            instances_with_nodes: Vec::new(),
+            instances: Vec::new(),
         }
     }
 
@@ -751,7 +770,40 @@ impl InpParser {
                         .push(format!("{name} at {file}:{}", ln + 1));
                 }
                 self.block = match name.as_str() {
-                    "*NODE" => Block::Node,
+                    "*NODE" => {
+                        if let Some(i) = &self.instance {
+                            if !self.instances_with_nodes.contains(i) {
+                                self.instances_with_nodes.push(i.clone());
+                            }
+                        } else if let Some(p) = &self.part {
+                            if !self.parts_with_nodes.contains(p) {
+                                self.parts_with_nodes.push(p.clone());
+                            }
+                        }
+                        Block::Node
+                    }
+                    "*PART" => {
+                        self.part = upper("NAME");
+                        Block::None
+                    }
+                    "*END PART" => {
+                        self.part = None;
+                        Block::None
+                    }
+                    "*INSTANCE" => {
+                        let inst = upper("NAME").unwrap_or_default();
+                        self.instances.push((
+                            inst.clone(),
+                            upper("PART").unwrap_or_default(),
+                            format!("{file}:{}", ln + 1),
+                        ));
+                        self.instance = Some(inst.clone());
+                        Block::InstanceData(inst)
+                    }
+                    "*END INSTANCE" => {
+                        self.instance = None;
+                        Block::None
+                    }
                     "*ELEMENT" => Block::Element(upper("TYPE").unwrap_or_default(), upper("ELSET")),
                     "*NSET" => Block::Nset(upper("NSET").unwrap_or_default(), gen),
                     "*ELSET" => Block::Elset(upper("ELSET").unwrap_or_default(), gen),
@@ -783,6 +835,23 @@ impl InpParser {
                 .collect();
             match &self.block {
                 Block::None => {}
+                Block::InstanceData(inst) => {
+                    // a translation (3 numbers) or rotation (7) line: only
+                    // the identity is accepted, since the coordinates are
+                    // read as written
+                    let moved = f.iter().any(|v| parse_f64(v).is_none_or(|x| x != 0.0));
+                    if moved {
+                        return Err(Error::parse(
+                            file,
+                            ln + 1,
+                            format!(
+                                "*INSTANCE {inst} is positioned by a translation or rotation ('{t}'), which this \
+                                 reader does not apply; write the deck with the instance at its part's position \
+                                 (or a flattened input file)"
+                            ),
+                        ));
+                    }
+                }
                 Block::Node => {
                     if f.len() < 3 {
                         return Err(Error::parse(
@@ -922,6 +991,46 @@ impl InpParser {
         Ok(())
     }
 
+    /// Node labels are unique only within an Abaqus part or instance: one
+    /// mesh is read, so nodes may come from one instance, or from one part
+    /// that is instanced once.
+    fn check_one_instance(&self, file: &str) -> Result<(), Error> {
+        if self.instances_with_nodes.len() > 1 {
+            return Err(Error::parse(
+                file,
+                0,
+                format!(
+                    "nodes are defined in {} instances ({}); their labels repeat between instances, and this reader \
+                     reads the mesh of one instance: export one part, or a flattened input file",
+                    self.instances_with_nodes.len(),
+                    self.instances_with_nodes.join(", ")
+                ),
+            ));
+        }
+        for part in &self.parts_with_nodes {
+            let of: Vec<&str> = self
+                .instances
+                .iter()
+                .filter(|(_, p, _)| p == part)
+                .map(|(i, _, _)| i.as_str())
+                .collect();
+            if of.len() > 1 || (self.parts_with_nodes.len() > 1 && !self.instances.is_empty()) {
+                return Err(Error::parse(
+                    file,
+                    0,
+                    format!(
+                        "part {part} is instanced {} times ({}) and the deck defines nodes in {} part(s); this reader \
+                         reads the mesh of one instance: export one part, or a flattened input file",
+                        of.len(),
+                        of.join(", "),
+                        self.parts_with_nodes.len()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     fn include(
         &mut self,
         input: &str,
@@ -959,6 +1068,7 @@ impl InpParser {
 
     fn finish(mut self, file: &str) -> Result<InpMesh, Error> {
         self.check_no_pending("incomplete element definition at the end of the file")?;
+        self.check_one_instance(file)?;
         if self.mesh.ids.is_empty() {
             return Err(Error::parse(file, 0, "no *NODE block"));
         }
@@ -1080,7 +1190,7 @@ fn calculix_from_mesh(
 
 /// The solid elements of `mesh` over the nodes of `model`, with the densities
 /// of the deck's *SOLID SECTION / *DENSITY.
-fn solid_elements(model: &FeModel, mesh: &InpMesh, deck: &str) -> SolidElements {
+pub(crate) fn solid_elements(model: &FeModel, mesh: &InpMesh, deck: &str) -> SolidElements {
     let mut out = SolidElements {
         density_source: format!("*DENSITY in {deck}"),
         couplings: mesh.couplings.clone(),
@@ -1125,7 +1235,7 @@ pub fn parse_calculix(
     )
 }
 
-fn model_from_parts(
+pub(crate) fn model_from_parts(
     name: &str,
     ids: Vec<u64>,
     coords: Vec<[f64; 3]>,
@@ -1187,7 +1297,7 @@ pub fn read_matrix_market_model(
 /// Checks that K and M are square, of one size, and of the size of the DOF
 /// list (`n` equations from `dof_file`, or 3 per node of the node file),
 /// naming the file that disagrees with the other two.
-fn check_matrix_market_sizes(
+pub(crate) fn check_matrix_market_sizes(
     [(k, kf), (m, mf)]: [(&SparseColMat<usize, f64>, &str); 2],
     n: usize,
     dof_file: &str,

@@ -18,11 +18,14 @@
 //! )
 //! ```
 
+use crate::abaqus::read_abaqus;
+use crate::ansys::{read_ansys, AnsysFiles};
 use crate::builder::{build, BuildResult, BuildSettings};
 use crate::model::{FeModel, ReferenceMass};
 use crate::readers::{
     read_calculix, read_matrix_market_model, write_file, write_matrix_market_dense,
 };
+use crate::units::{UnitSystem, UNIT_SYSTEMS};
 use crate::Error;
 use flexmb_element::LinearSuperelement;
 use serde::{Deserialize, Serialize};
@@ -64,6 +67,41 @@ pub enum ModelSource {
         #[serde(default)]
         density: Option<f64>,
     },
+    /// Abaqus `*MATRIX OUTPUT` files (`FORMAT=COORDINATE`, `MATRIX INPUT` or
+    /// `LABELS`) with the deck for the nodes, elements and densities
+    /// (module [`crate::abaqus`]).
+    Abaqus {
+        /// The `.inp` deck.
+        inp: String,
+        /// The stiffness file (`JOB_STIF1.mtx`).
+        k: String,
+        /// The mass file (`JOB_MASS1.mtx`).
+        m: String,
+        /// A uniform density (kg/m³) for the rigid-body check of M; replaces
+        /// the deck's *DENSITY.
+        #[serde(default)]
+        density: Option<f64>,
+    },
+    /// ANSYS exports: APDL Math MMF or `HBMAT` Harwell–Boeing K and M, the
+    /// DOF-mapping vector or `.mapping` file, the nodal coordinates and
+    /// optionally the element list (module [`crate::ansys`]).
+    Ansys {
+        /// Stiffness file.
+        k: String,
+        /// Mass file.
+        m: String,
+        /// The equation → node map.
+        mapping: String,
+        /// Nodal coordinates (decimal point or comma).
+        nodes: String,
+        /// Element listing, for the volume and the sparsity check.
+        #[serde(default)]
+        elements: Option<String>,
+        /// A uniform density (kg/m³) for the rigid-body check of M (needs
+        /// `elements`).
+        #[serde(default)]
+        density: Option<f64>,
+    },
 }
 
 /// A build specification.
@@ -74,6 +112,17 @@ pub struct Spec {
     pub name: String,
     /// The FE model.
     pub model: ModelSource,
+    /// The unit system of the FE files: "SI" (default), "mm-t-s",
+    /// "mm-kg-ms" or "mm-kg-s" ([`crate::units::UNIT_SYSTEMS`]).
+    #[serde(default)]
+    pub units: Option<String>,
+    /// A factor on the stiffness after the units (e.g. 1e-2 for K exported
+    /// with E = 2.1e11 from a model meant to have 2.1e9).
+    #[serde(default)]
+    pub stiffness_scale: Option<f64>,
+    /// A factor on the mass after the units.
+    #[serde(default)]
+    pub mass_scale: Option<f64>,
     /// What to build.
     pub settings: BuildSettings,
     /// The RON file to write the superelement to (relative to the spec's directory).
@@ -127,20 +176,31 @@ fn source_entry(path: &Path) -> Result<String, Error> {
     ))
 }
 
-/// Loads the model a spec names.
+/// The factors (length, stiffness, mass) that take the spec's FE files to
+/// SI (`units`, `stiffness_scale`, `mass_scale`).
+pub fn si_factors(spec: &Spec) -> Result<(f64, f64, f64), Error> {
+    let u = match &spec.units {
+        Some(name) => UnitSystem::named(name)?,
+        None => UNIT_SYSTEMS[0],
+    };
+    Ok(u.to_si(
+        spec.stiffness_scale.unwrap_or(1.0),
+        spec.mass_scale.unwrap_or(1.0),
+    ))
+}
+
+/// Loads the model a spec names, in SI (see [`si_factors`]).
 pub fn load_model(spec: &Spec, base_dir: &Path) -> Result<(FeModel, Vec<PathBuf>), Error> {
+    let (l, k, m) = si_factors(spec)?;
+    let rescale = |model: &mut FeModel| model.rescale(l, k, m);
     Ok(match &spec.model {
         ModelSource::CalculiX { job, inp, density } => {
             let job = base_dir.join(job);
             let inp = inp.as_ref().map(|p| base_dir.join(p));
             let (mut model, mesh) = read_calculix(&job, inp.as_deref())?;
             model.name = spec.name.clone();
-            if let Some(rho) = check_density(*density)? {
-                if let Some(solid) = &mut model.solid {
-                    solid.density = vec![Some(rho); solid.density.len()];
-                    solid.density_source = format!("the spec's density {rho} kg/m³");
-                }
-            }
+            rescale(&mut model)?;
+            override_density(&mut model, *density)?;
             // the .inp and everything it *INCLUDEs
             let files = ["sti", "mas", "dof"]
                 .iter()
@@ -160,6 +220,8 @@ pub fn load_model(spec: &Spec, base_dir: &Path) -> Result<(FeModel, Vec<PathBuf>
             let (k, m, nodes) = (base_dir.join(k), base_dir.join(m), base_dir.join(nodes));
             let dofs = dofs.as_ref().map(|d| base_dir.join(d));
             let mut model = read_matrix_market_model(&spec.name, &k, &m, &nodes, dofs.as_deref())?;
+            rescale(&mut model)?;
+            // the spec's volume and density are SI
             model.volume = *volume;
             if let Some(rho) = check_density(*density)? {
                 let v = volume.ok_or_else(|| {
@@ -177,7 +239,58 @@ pub fn load_model(spec: &Spec, base_dir: &Path) -> Result<(FeModel, Vec<PathBuf>
             files.extend(dofs);
             (model, files)
         }
+        ModelSource::Abaqus { inp, k, m, density } => {
+            let (inp, k, m) = (base_dir.join(inp), base_dir.join(k), base_dir.join(m));
+            let (mut model, mesh) = read_abaqus(&inp, &k, &m)?;
+            model.name = spec.name.clone();
+            rescale(&mut model)?;
+            override_density(&mut model, *density)?;
+            let files = [k, m].into_iter().chain(mesh.files).collect();
+            (model, files)
+        }
+        ModelSource::Ansys {
+            k,
+            m,
+            mapping,
+            nodes,
+            elements,
+            density,
+        } => {
+            let paths = [k, m, mapping, nodes].map(|p| base_dir.join(p));
+            let elements = elements.as_ref().map(|e| base_dir.join(e));
+            let files = AnsysFiles {
+                k: &paths[0],
+                m: &paths[1],
+                mapping: &paths[2],
+                nodes: &paths[3],
+                elements: elements.as_deref(),
+            };
+            let mut model = read_ansys(&spec.name, files)?;
+            rescale(&mut model)?;
+            if density.is_some() && model.solid.is_none() {
+                return Err(Error::Spec(
+                    "model: Ansys has a density but no elements; the density is checked against the elements' \
+                     volume"
+                        .into(),
+                ));
+            }
+            override_density(&mut model, *density)?;
+            let mut files: Vec<PathBuf> = paths.into();
+            files.extend(elements);
+            (model, files)
+        }
     })
+}
+
+/// Replaces the element densities by the spec's `density` (kg/m³), if given.
+fn override_density(model: &mut FeModel, density: Option<f64>) -> Result<(), Error> {
+    if let Some(rho) = check_density(density)? {
+        if let Some(solid) = &mut model.solid {
+            solid.density = vec![Some(rho); solid.density.len()];
+            solid.density_source = format!("the spec's density {rho} kg/m³");
+        }
+    }
+    Ok(())
 }
 
 /// A spec's density, which must be positive and finite if given.

@@ -72,6 +72,9 @@ fn matrix_market_round_trip_and_spec() {
             volume: Some(0.05 * 0.01 * 0.006),
             density: None,
         },
+        units: None,
+        stiffness_scale: None,
+        mass_scale: None,
         settings: settings.clone(),
         output: "small.se.ron".into(),
         m_bar_matrix_market: Some("m_bar.mtx".into()),
@@ -454,6 +457,9 @@ fn inp_includes_and_gmsh_layout() {
                 inp: None,
                 density: None,
             },
+            units: None,
+            stiffness_scale: None,
+            mass_scale: None,
             settings: BuildSettings::new(
                 [0.0; 3],
                 [1.0, 0.0, 0.0],
@@ -509,6 +515,9 @@ fn misspelt_fields_in_specs_and_superelement_files_are_refused() {
             inp: None,
             density: None,
         },
+        units: None,
+        stiffness_scale: None,
+        mass_scale: None,
         settings: BuildSettings {
             normal_modes: 6,
             ..settings.clone()
