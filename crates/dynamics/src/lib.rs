@@ -1,9 +1,15 @@
 //! Equations of motion of flexible multibody mechanisms in independent
 //! coordinates (thesis Appendix D and E):
 //!
-//! * [`Dynamics::accelerations`]: Mq q̈ = F,qᵀ(f − Mx ẍ0 − h) − E,qᵀσ (D.10), with
-//!   Mq = F,qᵀ Mx F,q assembled element by element (no dense Mx) and
-//!   σ = Sε + Dε̇ + σ0 (E.2) including damping, initial stress and PD controllers;
+//! * [`Dynamics::accelerations`]: the q̈ of Mq q̈ = F,qᵀ(f − Mx ẍ0 − h) − E,qᵀσ
+//!   (D.10), with σ = Sε + Dε̇ + σ0 (E.2) including damping, initial stress and
+//!   PD controllers. It is solved in nodal coordinates with multipliers for the
+//!   rigid and prescribed deformations (the `nodal_eom` module: a sparse
+//!   skyline factor of Mx, no F,q and no Mq); only when that system cannot be
+//!   solved does it fall back to
+//!   [`Dynamics::accelerations_by_projection`], which assembles
+//!   Mq = F,qᵀ Mx F,q element by element and whose errors name the
+//!   coordinates;
 //! * [`Dynamics::residual`]: g(q, q̇, q̈, t) of (E.1);
 //! * [`Dynamics::static_equilibrium`]: Newton on Kq + Gq (E.6) with load
 //!   increments and held degrees of freedom;

@@ -18,14 +18,16 @@
 //! deformation, and q̈ follows from ẍ: a nodal DOF is ẍᵢ itself, a
 //! deformation DOF is ε̈ = D,x ẍ + D,xx\[ẋ, ẋ\] (5.8b).
 //!
-//! The system is solved by its Schur complement. Mx is singular along each
-//! Euler parameter vector (and for massless coordinates), so it is first
-//! augmented by CᵀWC (W > 0 diagonal) and the first right-hand side by
-//! CᵀW(second), which leaves the solution unchanged because Cẍ equals the
-//! second right-hand side (the augmented Lagrangian form). Mx + CᵀWC is
-//! positive definite whenever Mq = F,qᵀMxF,q is, and has the sparsity of
-//! Mx: it is factorized as a skyline after a reverse Cuthill–McKee
-//! ordering. Then S = C(Mx + CᵀWC)⁻¹Cᵀ = YᵀY with Y = L⁻¹Cᵀ, μ from S, and ẍ
+//! The system is solved by its Schur complement. Mx (of the free nodal
+//! coordinates, in skyline storage after a reverse Cuthill–McKee ordering)
+//! is factorized as it is first. Only when that factorization fails (Mx is
+//! singular along an Euler parameter vector that carries no rotational
+//! inertia, or for massless coordinates) is it augmented by CᵀWC (W > 0
+//! diagonal) and the first right-hand side by CᵀW(second), which leaves the
+//! solution unchanged because Cẍ equals the second right-hand side (the
+//! augmented Lagrangian form), and factorized again; `augmented` records
+//! which happened. Mx + CᵀWC is positive definite whenever
+//! Mq = F,qᵀMxF,q is, and has the sparsity of Mx. Then S = C(Mx + CᵀWC)⁻¹Cᵀ = YᵀY with Y = L⁻¹Cᵀ, μ from S, and ẍ
 //! by one more back substitution. For a chain of n bodies the work is
 //! O(n b²) for the factor (b the band) and O(n n_c²) for S, against
 //! O(n_x n_q²) for forming F,q and Mq.
