@@ -63,16 +63,23 @@ pub struct SimulationOptions {
 }
 
 impl SimulationOptions {
-    /// ode45's defaults (RelTol 1e-3, AbsTol 1e-6) with `n` equidistant outputs on [t0, t_end].
+    /// ode45's defaults (RelTol 1e-3, AbsTol 1e-6) with `n` equidistant
+    /// outputs on [t0, t_end]. `n` = 1 gives the final state only; `n` = 0
+    /// no output time at all, which [`Dynamics::simulate`] refuses with an
+    /// error (it is not silently raised to 2).
     pub fn new(integrator: Integrator, t0: f64, t_end: f64, n: usize) -> Self {
-        let n = n.max(2);
+        let output_times = match n {
+            0 => vec![],
+            1 => vec![t_end],
+            _ => (0..n)
+                .map(|k| t0 + (t_end - t0) * k as f64 / (n - 1) as f64)
+                .collect(),
+        };
         Self {
             integrator,
             rtol: 1e-3,
             atol: 1e-6,
-            output_times: (0..n)
-                .map(|k| t0 + (t_end - t0) * k as f64 / (n - 1) as f64)
-                .collect(),
+            output_times,
             stop: None,
         }
     }

@@ -161,3 +161,51 @@ fn a_singular_static_tangent_names_the_unrestrained_coordinates() {
     assert!(named.contains("S.y (node S)"), "{msg}");
     assert!(!named.contains("ab.") && !named.contains("bs."), "{msg}");
 }
+
+/// `SimulationOptions::new` with fewer than two outputs is what was asked:
+/// one output is the final state, none is an error (both used to become two
+/// outputs silently).
+#[test]
+fn one_output_is_the_final_state_and_none_is_an_error() {
+    let scene = Scene::from_ron_str(
+        r#"(
+        dimension: Planar,
+        gravity: Some([0.0, -9.81]),
+        materials: { "m": (e: 1.0e9, rho: 0.0) },
+        sections: { "s": Circle(d: 0.01) },
+        nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [1.0, 0.0]) ],
+        elements: [
+            (id: "rod", type: Beam((nodes: ("A", "B"), material: "m", section: "s", mass: false))),
+            (id: "bob", type: PointMass(node: "B", mass: 2.0)),
+        ],
+        fixed: [ Coord("A", Position) ],
+        rigid: [ Def("rod", "*") ],
+    )"#,
+    )
+    .unwrap();
+    let mech = Arc::new(scene.build(None).unwrap());
+    let mut dy = Dynamics::new(mech.clone());
+    let q0 = mech.q0();
+    let qd0 = vec![0.0; q0.len()];
+    let three = SimulationOptions::new(Integrator::Dopri5, 0.0, 0.5, 3);
+    let one = SimulationOptions::new(Integrator::Dopri5, 0.0, 0.5, 1);
+    assert_eq!(one.output_times, vec![0.5]);
+    let a = dy
+        .simulate(0.0, &q0, &qd0, &three, |_, _, _| Control::Continue)
+        .unwrap();
+    let b = dy
+        .simulate(0.0, &q0, &qd0, &one, |_, _, _| Control::Continue)
+        .unwrap();
+    assert_eq!(b.t, vec![0.5]);
+    let (qa, qb) = (a.q.last().unwrap(), &b.q[0]);
+    assert!(
+        (qa[0] - qb[0]).abs() < 1e-3 && qa[0] < -0.5,
+        "{qa:?} {qb:?}"
+    );
+    let none = SimulationOptions::new(Integrator::Dopri5, 0.0, 0.5, 0);
+    let e = dy
+        .simulate(0.0, &q0, &qd0, &none, |_, _, _| Control::Continue)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no output times"), "{e}");
+}
