@@ -654,10 +654,20 @@ impl Kinematics {
 
     fn solve_inner(&mut self, q: &[f64], t: f64, mode: Refactor) -> Result<(), KinematicsError> {
         if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+            // every non-finite entry (up to three by name), not just the first
+            let bad: Vec<usize> = (i..q.len()).filter(|&k| !q[k].is_finite()).collect();
+            let mut names: Vec<String> = bad
+                .iter()
+                .take(3)
+                .map(|&k| self.mech.dof_label(k))
+                .collect();
+            if bad.len() > 3 {
+                names.push(format!("{} more", bad.len() - 3));
+            }
             return Err(KinematicsError::NonFinite {
                 what: "q",
                 index: i,
-                name: self.mech.dof_label(i),
+                name: names.join(", "),
             });
         }
         let n_u = self.n_u;

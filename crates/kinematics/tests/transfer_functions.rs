@@ -509,3 +509,25 @@ fn the_position_solve_converges_at_the_rounding_of_the_coordinates() {
     );
     assert!(near.1.abs() > 1e-5, "the cantilever is bent: {near:?}");
 }
+
+/// A q with several non-finite entries names each of them (up to three and a
+/// count), not only the first.
+#[test]
+fn every_non_finite_entry_of_q_is_named() {
+    let mut k = kinematics("straight_guidance_spatial.ron", DofChoice::Deformations);
+    let mut q = k.mechanism().q0();
+    assert!(q.len() > 8);
+    for i in [2, 4, 5, 7, 8] {
+        q[i] = f64::NAN;
+    }
+    let e = k.solve(&q, 0.0).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(e, KinematicsError::NonFinite { index: 2, .. }),
+        "{msg}"
+    );
+    for i in [2, 4, 5] {
+        assert!(msg.contains(&format!("q{i} ")), "q{i} not named: {msg}");
+    }
+    assert!(msg.contains("2 more"), "{msg}");
+}
