@@ -762,12 +762,33 @@ impl Dynamics {
                     stopped_at: None,
                 };
                 let mut last_output = f64::NEG_INFINITY;
-                let sol = GeneralizedAlpha::new(o)
-                    .solve_with(&mut sys, t0, q0, qd0, t_end, &out, |t, q, qd, _| {
+                let sol = match GeneralizedAlpha::new(o).solve_with(
+                    &mut sys,
+                    t0,
+                    q0,
+                    qd0,
+                    t_end,
+                    &out,
+                    |t, q, qd, _| {
                         last_output = t;
                         emit(t, q, qd)
-                    })
-                    .map_err(|e| sys.watch.with_cause(to_err(e)))?;
+                    },
+                ) {
+                    Ok(sol) => sol,
+                    // the start-up mass matrix is singular: the projection's
+                    // Mq names the degrees of freedom without inertia, as
+                    // DOPRI5 and Adams report them
+                    Err(e @ flexmb_ode::OdeError::SingularMatrix { what: "mass", .. }) => {
+                        let mut qdd = vec![0.0; q0.len()];
+                        let named = match sys.dy.accelerations_by_projection(t0, q0, qd0, &mut qdd)
+                        {
+                            Err(named @ DynamicsError::SingularMass { .. }) => named,
+                            _ => to_err(e),
+                        };
+                        return Err(sys.watch.with_cause(named));
+                    }
+                    Err(e) => return Err(sys.watch.with_cause(to_err(e))),
+                };
                 if let Some((t, q, qd)) = sys.stopped_at.take() {
                     if t > last_output {
                         emit(t, &q, &qd);

@@ -209,3 +209,42 @@ fn one_output_is_the_final_state_and_none_is_an_error() {
         .to_string();
     assert!(e.contains("no output times"), "{e}");
 }
+
+/// A degree of freedom without inertia is named by every integrator
+/// (generalized-α used to say only "singular mass matrix at t = 0").
+#[test]
+fn a_massless_degree_of_freedom_is_named_by_every_integrator() {
+    let scene = Scene::from_ron_str(
+        r#"(
+        dimension: Planar,
+        materials: { "m": (e: 1.0e9, rho: 0.0) },
+        sections: { "s": Circle(d: 0.01) },
+        nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [1.0, 0.0]) ],
+        elements: [
+            (id: "rod", type: Beam((nodes: ("A", "B"), material: "m", section: "s", mass: false))),
+            (id: "bob", type: PointMass(node: "B", mass: 2.0)),
+        ],
+        fixed: [ Coord("A", Position) ],
+    )"#,
+    )
+    .unwrap();
+    let mech = Arc::new(scene.build(None).unwrap());
+    let q0 = mech.q0();
+    let qd0 = vec![0.0; q0.len()];
+    for integrator in [
+        Integrator::Dopri5,
+        Integrator::Adams,
+        Integrator::GeneralizedAlpha,
+    ] {
+        let mut dy = Dynamics::new(mech.clone());
+        let opts = SimulationOptions::new(integrator, 0.0, 0.1, 3);
+        let e = dy
+            .simulate(0.0, &q0, &qd0, &opts, |_, _, _| Control::Continue)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("degrees of freedom without inertia: DOF q2 = rod.bending_q"),
+            "{integrator:?}: {e}"
+        );
+    }
+}
