@@ -52,7 +52,7 @@ pub use basis::{
 };
 pub use continuation::{continue_load_scale, load_scale_path, SUBSTEPS};
 pub use ibm::{interpolated_basis_from_sweep, InterpolatedBasis, Knots, SubspaceInterpolation};
-pub use mechanical::{Equilibrium, MechanicalModel, ModelTrajectory, SweepPoint};
+pub use mechanical::{Equilibrium, MechanicalModel, ModelTrajectory, StateObserver, SweepPoint};
 pub use model::{ReducedLinearization, ReducedModel, ReducedTrajectory};
 pub use msi::{largest_principal_angle, mac_sorted, modal_subspace_interpolation, orthonormalize};
 pub use path::{

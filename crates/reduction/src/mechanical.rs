@@ -11,6 +11,10 @@ use flexmb_dynamics::{
 use flexmb_model::Mechanism;
 use std::sync::Arc;
 
+/// An observer of a run: `observer(t, c, ċ)` at each output time, the
+/// model's coordinates and their rates; [`Control::Stop`] ends the run.
+pub type StateObserver<'a> = &'a mut dyn FnMut(f64, &[f64], &[f64]) -> Control;
+
 /// A static equilibrium of a model: its coordinates (q or z) and the
 /// unreduced configuration x the solver converged to. Start later position
 /// solves at this state from `x` (a solve from a far-away configuration can
@@ -124,7 +128,7 @@ pub trait MechanicalModel {
         c0: &[f64],
         cd0: &[f64],
         opts: &SimulationOptions,
-        observer: &mut dyn FnMut(f64, &[f64], &[f64]) -> Control,
+        observer: StateObserver<'_>,
     ) -> Result<ModelTrajectory, ReductionError>;
 
     /// [`simulate`](Self::simulate), recording the rows of `table` (the
@@ -286,7 +290,7 @@ impl MechanicalModel for Dynamics {
         c0: &[f64],
         cd0: &[f64],
         opts: &SimulationOptions,
-        observer: &mut dyn FnMut(f64, &[f64], &[f64]) -> Control,
+        observer: StateObserver<'_>,
     ) -> Result<ModelTrajectory, ReductionError> {
         let full = Dynamics::simulate(self, t0, c0, cd0, opts, observer)?;
         Ok(ModelTrajectory {
@@ -414,7 +418,7 @@ impl MechanicalModel for ReducedModel {
         c0: &[f64],
         cd0: &[f64],
         opts: &SimulationOptions,
-        observer: &mut dyn FnMut(f64, &[f64], &[f64]) -> Control,
+        observer: StateObserver<'_>,
     ) -> Result<ModelTrajectory, ReductionError> {
         if opts.integrator == Integrator::GeneralizedAlpha {
             return Err(ReductionError::Invalid(
