@@ -82,10 +82,12 @@ pub trait MechanicalModel {
     /// The static equilibrium at time `t` by Newton from `start`, the
     /// coordinates of `opts.held` held at their values. The unreduced model
     /// follows all of `opts` ([`Dynamics::static_equilibrium`]); the reduced
-    /// one takes the held values and solves at the current load scale in one
-    /// Newton iteration (converged when ‖Δz‖∞ ≤ 1e-10 (1 + ‖z‖∞), at most 30
-    /// iterations; the other settings are the unreduced solver's): a load
-    /// ramp of a reduced model is [`equilibria_over_load_scale`](Self::equilibria_over_load_scale).
+    /// one takes the held values and solves at the current load scale by one
+    /// damped Newton solve ([`ReducedModel::newton_equilibrium`]: converged
+    /// when ‖Δz‖∞ ≤ 1e-10 (1 + ‖z‖∞), at most 30 iterations; the load steps,
+    /// ramp, tolerances and stop flag of `opts` are the unreduced solver's):
+    /// a load ramp of a reduced model is
+    /// [`equilibria_over_load_scale`](Self::equilibria_over_load_scale).
     fn static_equilibrium(
         &mut self,
         t: f64,
