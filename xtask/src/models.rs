@@ -3,9 +3,8 @@
 //! time responses with their cost.
 
 use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions, StaticOptions};
-use flexmb_linearize::undamped_modes;
 use flexmb_model::Mechanism;
-use flexmb_reduction::{load_scale_path, Basis, FixedBasis, InterpolatedBasis, ReducedModel};
+use flexmb_reduction::{Basis, FixedBasis, InterpolatedBasis, MechanicalModel, ReducedModel};
 use std::sync::Arc;
 
 /// How a model constrains the degrees of freedom.
@@ -40,14 +39,15 @@ impl Model {
         }
     }
 
-    /// The reduced model, if reduced.
-    pub fn reduced(&self) -> Option<ReducedModel> {
+    /// A fresh instance of the model: the unreduced dynamics or the reduced
+    /// model over its basis, behind the one interface of both.
+    pub fn instance(&self) -> Box<dyn MechanicalModel> {
         let b: Box<dyn Basis> = match &self.kind {
-            ModelKind::Unreduced => return None,
+            ModelKind::Unreduced => return Box::new(Dynamics::new(self.mech.clone())),
             ModelKind::Fixed(b) => Box::new(b.clone()),
             ModelKind::Interpolated(b) => b.clone(),
         };
-        Some(ReducedModel::new(self.mech.clone(), b))
+        Box::new(ReducedModel::new(self.mech.clone(), b))
     }
 
     /// Number of coordinates integrated (n_q or n_z).
@@ -102,94 +102,6 @@ pub struct CurvePoint {
     pub highest: f64,
 }
 
-/// The state a continuation carries: q (unreduced) or z (reduced).
-enum Solver {
-    Full(Box<Dynamics>, Vec<f64>),
-    Reduced(Box<ReducedModel>, Vec<f64>),
-}
-
-impl Solver {
-    fn new(model: &Model) -> Self {
-        match model.reduced() {
-            None => Solver::Full(Box::new(Dynamics::new(model.mech.clone())), model.mech.q0()),
-            Some(r) => {
-                let z = r.basis().z_reference();
-                Solver::Reduced(Box::new(r), z)
-            }
-        }
-    }
-    fn state(&self) -> Vec<f64> {
-        match self {
-            Solver::Full(_, q) | Solver::Reduced(_, q) => q.clone(),
-        }
-    }
-    fn set_state(&mut self, s: Vec<f64>) {
-        match self {
-            Solver::Full(_, q) | Solver::Reduced(_, q) => *q = s,
-        }
-    }
-    /// Scales the scene's loads by λ (gravity stays).
-    fn set_load_scale(&mut self, lambda: f64) {
-        match self {
-            Solver::Full(dy, _) => dy.set_load_scale(lambda),
-            Solver::Reduced(r, _) => r.set_load_scale(lambda),
-        }
-    }
-    /// Equilibrium at load scale λ from the current state.
-    fn equilibrium(&mut self, t: f64, lambda: f64, first: bool) -> Result<(), String> {
-        match self {
-            Solver::Full(dy, q) => {
-                dy.set_load_scale(lambda);
-                let o = StaticOptions {
-                    ramp_loads: first,
-                    ..Default::default()
-                };
-                *q = dy
-                    .static_equilibrium(t, q, &o)
-                    .map_err(|e| e.to_string())?
-                    .q;
-            }
-            Solver::Reduced(r, z) => {
-                r.set_load_scale(lambda);
-                *z = r.static_equilibrium(t, z, &[]).map_err(|e| e.to_string())?;
-            }
-        }
-        Ok(())
-    }
-    /// The nodal coordinates of the last position solve.
-    fn x(&self) -> Vec<f64> {
-        match self {
-            Solver::Full(dy, _) => dy.kinematics().x().to_vec(),
-            Solver::Reduced(r, _) => r.dynamics().kinematics().x().to_vec(),
-        }
-    }
-    /// Starts the next position solve at the configuration x.
-    fn set_guess(&mut self, x: &[f64]) {
-        match self {
-            Solver::Full(dy, _) => dy.kinematics_mut().set_guess(x),
-            Solver::Reduced(r, _) => r.dynamics_mut().kinematics_mut().set_guess(x),
-        }
-    }
-    /// Eigenfrequencies at the current state (load scale as last set).
-    fn frequencies(&mut self, t: f64, count: usize) -> Result<(Vec<f64>, f64), String> {
-        match self {
-            Solver::Full(dy, q) => {
-                let lin = dy.linearize_at_rest(t, q).map_err(|e| e.to_string())?;
-                let all = undamped_modes(&lin, lin.m.nrows()).map_err(|e| e.to_string())?;
-                let f = all.frequencies_hz();
-                let highest = f.last().copied().unwrap_or(0.0);
-                Ok((f.into_iter().take(count).collect(), highest))
-            }
-            Solver::Reduced(r, z) => {
-                let z = z.clone();
-                let f = r.frequencies_at_rest(t, &z).map_err(|e| e.to_string())?;
-                let highest = f.last().copied().unwrap_or(0.0);
-                Ok((f, highest))
-            }
-        }
-    }
-}
-
 /// The quasi-static eigenfrequency curve of a model: at each load scale of
 /// `lambdas` (loads evaluated at `t`, gravity as in the scene) the static
 /// equilibrium by continuation from λ = 0 outwards
@@ -203,40 +115,24 @@ pub fn quasi_static_curve(
     node: &str,
     count: usize,
 ) -> Result<Vec<CurvePoint>, String> {
-    let ctx = |e: String| format!("{}: {e}", model.name);
+    let ctx = |e: flexmb_reduction::ReductionError| format!("{}: {e}", model.name);
     let probe = NodeProbe::new(&model.mech, node)?;
-    let mut s = Solver::new(model);
-    s.equilibrium(t, 0.0, true).map_err(ctx)?;
-    // a state is the equilibrium and its configuration: every position solve
-    // starts at the configuration of the equilibrium it continues from or
-    // evaluates, never at another end of the path
-    let at_zero = (s.state(), s.x());
-    // continuation outwards from λ = 0 (shared with `flexmb sweep --reduced`)
-    type State = (Vec<f64>, Vec<f64>);
-    let mut solve = |state: &State, l: f64| -> Result<State, String> {
-        s.set_state(state.0.clone());
-        s.set_guess(&state.1);
-        s.equilibrium(t, l, false)?;
-        Ok((s.state(), s.x()))
-    };
-    let states = load_scale_path(&at_zero, lambdas, &mut solve, &mut |_| {})
-        .map_err(|e| ctx(e.to_string()))?;
-    lambdas
-        .iter()
-        .zip(states)
-        .map(|(l, (state, x))| {
-            s.set_state(state);
-            s.set_guess(&x);
-            s.set_load_scale(*l);
-            let (freqs, highest) = s.frequencies(t, count).map_err(ctx)?;
-            Ok(CurvePoint {
-                lambda: *l,
-                position: probe.displacement_in(&x),
-                freqs,
-                highest,
-            })
+    let mut m = model.instance();
+    // all frequencies, for the highest; a reduced model keeps all of them
+    let all = m.n_coordinates();
+    let keep = if m.is_reduced() { all } else { count };
+    let points = m
+        .frequency_sweep(t, lambdas, all, &mut |_| Control::Continue)
+        .map_err(ctx)?;
+    Ok(points
+        .into_iter()
+        .map(|p| CurvePoint {
+            lambda: p.load_scale,
+            position: probe.displacement_in(&p.equilibrium.x),
+            highest: p.frequencies.last().copied().unwrap_or(0.0),
+            freqs: p.frequencies.into_iter().take(keep).collect(),
         })
-        .collect()
+        .collect())
 }
 
 /// A time response and what it cost.
@@ -283,48 +179,27 @@ pub fn simulate(
         opts.atol
     );
     let probe = NodeProbe::new(&model.mech, node)?;
-    let mut s = Solver::new(model);
-    s.equilibrium(t0, 1.0, true).map_err(ctx)?;
-    let start = s.state();
-    let (t, q, x, z, evaluations, steps, wall_time) = match s {
-        Solver::Full(mut dy, _) => {
-            let qd0 = vec![0.0; start.len()];
-            let tr = dy
-                .simulate(t0, &start, &qd0, opts, |t, _, _| {
-                    progress(t);
-                    Control::Continue
-                })
-                .map_err(|e| ctx(e.to_string()))?;
-            (
-                tr.t,
-                tr.q,
-                tr.x,
-                None,
-                tr.stats.rhs_evals as u64,
-                tr.stats.steps_accepted as u64,
-                tr.wall_time,
-            )
-        }
-        Solver::Reduced(mut r, _) => {
-            let zd0 = vec![0.0; start.len()];
-            let tr = r
-                .simulate(t0, &start, &zd0, opts, |t, _, _| {
-                    progress(t);
-                    Control::Continue
-                })
-                .map_err(|e| ctx(e.to_string()))?;
-            let q: Vec<Vec<f64>> = tr.z.iter().map(|z| r.full_coordinates(z)).collect();
-            (
-                tr.t,
-                q,
-                tr.x,
-                Some(tr.z),
-                tr.stats.rhs_evals as u64,
-                tr.stats.steps_accepted as u64,
-                tr.wall_time,
-            )
-        }
-    };
+    let mut m = model.instance();
+    // the static equilibrium at t0 under the full loads, from the reference
+    m.set_load_scale(1.0);
+    let reference = m.reference_coordinates();
+    let start = m
+        .static_equilibrium(t0, &reference, &StaticOptions::default())
+        .map_err(|e| ctx(e.to_string()))?
+        .coordinates;
+    let cd0 = vec![0.0; start.len()];
+    let tr = m
+        .simulate(t0, &start, &cd0, opts, &mut |t, _, _| {
+            progress(t);
+            Control::Continue
+        })
+        .map_err(|e| ctx(e.to_string()))?;
+    let z = m.is_reduced().then_some(tr.coordinates);
+    let full = tr.full;
+    let (t, q, x) = (full.t, full.q, full.x);
+    let evaluations = full.stats.rhs_evals as u64;
+    let steps = full.stats.steps_accepted as u64;
+    let wall_time = full.wall_time;
     // from the configurations solved along the run (not again afterwards)
     let position = x.iter().map(|xx| probe.displacement_in(xx)).collect();
     Ok(Response {
@@ -349,24 +224,9 @@ pub fn frequencies_along(
     count: usize,
 ) -> Result<Vec<f64>, String> {
     let t = r.t[i];
-    // the position solves start at the configuration of the response there
-    match (model.reduced(), &r.z) {
-        (Some(mut red), Some(z)) => {
-            red.dynamics_mut().kinematics_mut().set_guess(&r.x[i]);
-            let f = red
-                .frequencies_at_rest(t, &z[i])
-                .map_err(|e| e.to_string())?;
-            Ok(f.into_iter().take(count).collect())
-        }
-        _ => {
-            let mut dy = Dynamics::new(model.mech.clone());
-            dy.kinematics_mut().set_guess(&r.x[i]);
-            let lin = dy
-                .linearize_at_rest(t, &r.q[i])
-                .map_err(|e| e.to_string())?;
-            Ok(undamped_modes(&lin, count)
-                .map_err(|e| e.to_string())?
-                .frequencies_hz())
-        }
-    }
+    let mut m = model.instance();
+    // the position solve starts at the configuration of the response there
+    m.dynamics_mut().kinematics_mut().set_guess(&r.x[i]);
+    let c = r.z.as_ref().map_or(&r.q[i], |z| &z[i]);
+    m.eigenfrequencies(t, c, count).map_err(|e| e.to_string())
 }

@@ -26,6 +26,7 @@ use flexmb_dynamics::{
 };
 use flexmb_model::Scene;
 use flexmb_plot::write_csv;
+use flexmb_reduction::MechanicalModel;
 use out::{errln, say};
 use report::{
     count_bar, linspace, time_bar, write_frequency_sweep, write_outputs, FrequencySweep,
@@ -380,21 +381,24 @@ fn simulate(a: &SimulateArgs) -> Result<(), Failure> {
         pb.set_message(format!("{t:.4}"));
         Control::Continue
     };
-    let mut dy = Dynamics::new(mech.clone());
-    let result = match &a.reduced {
+    let (mut model, description, interpolated) = match &a.reduced {
         None => {
             say!("{}", mech.summary());
-            simulate_unreduced(&mut dy, &opts, a.static_first, observer)
-                .map(|(r, rows)| (r, None, Some(rows)))
+            let dy: Box<dyn MechanicalModel> = Box::new(Dynamics::new(mech.clone()));
+            (dy, None, false)
         }
-        Some(model) => reduced::simulate(&mech, model, &opts, a.static_first, observer)
-            .map(|(r, d)| (r, Some(d), None)),
+        Some(file) => {
+            let (model, d, interpolated) = reduced::model_to_simulate(&mech, file, &opts)?;
+            (model, Some(d), interpolated)
+        }
     };
+    let c0 = start_state(model.as_mut(), a.static_first, interpolated)?;
+    let result = simulate_model(model.as_mut(), &c0, &opts, observer);
     pb.finish_and_clear();
-    let (response, model, rows) = result?;
+    let (response, rows) = result?;
     say!("{}", report::summary(&response));
     let mut comments = vec![format!("flexmb simulate {}", a.scene.display())];
-    if let (Some(m), Some(d)) = (&a.reduced, &model) {
+    if let (Some(m), Some(d)) = (&a.reduced, &description) {
         comments.push(format!("reduced model {}: {d}", m.display()));
     }
     comments.push(format!(
@@ -405,7 +409,7 @@ fn simulate(a: &SimulateArgs) -> Result<(), Failure> {
     if let Some(p) = &partial {
         comments.push(format!("interrupted: {p}"));
     }
-    write_outputs(&mut dy, &response, rows, &comments, &a.out)?;
+    write_outputs(model.dynamics(), rows, &comments, &a.out)?;
     match partial {
         Some(p) => Err(Failure::Interrupted(format!(
             "partial results written: {p}"
@@ -429,53 +433,68 @@ fn stopped_run(r: &Response, opts: &SimulationOptions) -> String {
     }
 }
 
-/// Integrates all degrees of freedom from the reference configuration (or
-/// the static equilibrium) with the scene's initial velocities.
-fn simulate_unreduced(
-    dy: &mut Dynamics,
-    opts: &SimulationOptions,
+/// The coordinates a run starts from: the model's reference coordinates, or
+/// with `static_first` its static equilibrium under the loads and gravity at
+/// t = 0 ([`MechanicalModel::equilibrium_under_loads`]); the loads at full
+/// scale. An interpolated reduced model says where on its path it starts.
+fn start_state(
+    model: &mut dyn MechanicalModel,
     static_first: bool,
+    interpolated: bool,
+) -> Result<Vec<f64>, Failure> {
+    let c0 = if static_first {
+        let what = if model.is_reduced() {
+            "reduced static equilibrium: "
+        } else {
+            ""
+        };
+        model
+            .equilibrium_under_loads(0.0)
+            .map_err(|e| Failure::Compute(format!("{what}{e}")))?
+            .coordinates
+    } else {
+        model.reference_coordinates()
+    };
+    model.set_load_scale(1.0);
+    if interpolated {
+        say!(
+            "initial s = {:.6e} ({})",
+            c0[0],
+            if static_first {
+                "static equilibrium"
+            } else {
+                "the knot nearest to the scene's reference configuration"
+            }
+        );
+    }
+    Ok(c0)
+}
+
+/// Integrates `model` (all degrees of freedom or a reduced model) from the
+/// coordinates `c0` with the scene's initial velocities
+/// ([`MechanicalModel::initial_velocities`]), recording the scene's outputs
+/// at each output time (t first).
+fn simulate_model(
+    model: &mut dyn MechanicalModel,
+    c0: &[f64],
+    opts: &SimulationOptions,
     mut observer: impl FnMut(f64) -> Control,
 ) -> Result<(Response, OutputRows), Failure> {
-    let mut q0 = dy.mechanism().q0();
-    if static_first {
-        q0 = dy
-            .static_equilibrium(0.0, &q0, &StaticOptions::default())
-            .map_err(|e| Failure::Compute(e.to_string()))?
-            .q;
-    }
-    let qd0 = dy
-        .initial_qd(0.0, &q0)
-        .map_err(|e| Failure::Compute(e.to_string()))?;
-    // the output rows, evaluated when the integrator reaches each output, in
-    // the chart of the orientations the run has there
-    let table = OutputTable::new(dy).map_err(|e| Failure::Input(e.to_string()))?;
-    let mut rows = vec![];
-    let mut failure = None;
+    let compute = |e: flexmb_reduction::ReductionError| Failure::Compute(e.to_string());
+    let cd0 = model.initial_velocities(0.0, c0).map_err(compute)?;
+    let table = OutputTable::new(model.dynamics()).map_err(|e| Failure::Input(e.to_string()))?;
     let phase = interrupt::stoppable();
-    let traj = dy
-        .simulate_with(0.0, &q0, &qd0, opts, |p| {
-            let x = p.dynamics.kinematics().x().to_vec();
-            match table.row(p.dynamics, p.t, p.q_chart, p.qd_chart, &x) {
-                Ok(r) => {
-                    let mut row = vec![p.t];
-                    row.extend(r);
-                    rows.push(row);
-                    observer(p.t)
-                }
-                Err(e) => {
-                    failure = Some(e);
-                    Control::Stop
-                }
-            }
-        })
-        .map_err(|e| Failure::Compute(e.to_string()));
+    let run = model.simulate_outputs(0.0, c0, &cd0, opts, &table, &mut observer);
     phase.finish();
-    let traj = traj?;
-    if let Some(e) = failure {
-        return Err(Failure::Compute(e.to_string()));
-    }
-    Ok((traj, rows))
+    let (traj, rows) = run.map_err(compute)?;
+    let rows = traj
+        .full
+        .t
+        .iter()
+        .zip(rows)
+        .map(|(t, r)| std::iter::once(*t).chain(r).collect())
+        .collect();
+    Ok((traj.full, rows))
 }
 
 /// `flexmb eig`: the first `k` eigenfrequencies at the reference

@@ -3,11 +3,11 @@
 //! freedom.
 
 use crate::out::say;
-use crate::report::{count_bar, write_frequency_sweep, FrequencySweep, Response};
+use crate::report::{count_bar, write_frequency_sweep, FrequencySweep};
 use crate::{Failure, SweepArgs};
 use flexmb_dynamics::{Control, Integrator, SimulationOptions};
 use flexmb_model::Mechanism;
-use flexmb_reduction::{ReducedModel, SavedBasis, SavedModel};
+use flexmb_reduction::{MechanicalModel, ReducedModel, SavedBasis, SavedModel};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -29,18 +29,13 @@ fn load_model(mech: &Arc<Mechanism>, path: &Path) -> Result<(SavedModel, Reduced
     Ok((saved, red))
 }
 
-/// Integrates the reduced model `model` of `mech` from its reference
-/// coordinates (or its static equilibrium under the loads and gravity at
-/// t = 0, by load-scale continuation) with the scene's initial velocities
-/// projected on the basis; returns the response mapped to q and the model's
-/// description.
-pub(crate) fn simulate(
+/// The reduced model `model` of `mech` to simulate, its description, and
+/// whether its basis is interpolated; explicit integrators only.
+pub(crate) fn model_to_simulate(
     mech: &Arc<Mechanism>,
     model: &Path,
     opts: &SimulationOptions,
-    static_first: bool,
-    mut observer: impl FnMut(f64) -> Control,
-) -> Result<(Response, String), Failure> {
+) -> Result<(Box<dyn MechanicalModel>, String, bool), Failure> {
     if opts.integrator == Integrator::GeneralizedAlpha {
         return Err(Failure::Input(
             "a reduced model is integrated with an explicit integrator (--integrator dopri5 or \
@@ -49,62 +44,9 @@ pub(crate) fn simulate(
                 .into(),
         ));
     }
-    let (saved, mut red) = load_model(mech, model)?;
-    let compute = |e: flexmb_reduction::ReductionError| Failure::Compute(e.to_string());
-    let z0 = if static_first {
-        let z = red
-            .equilibria_over_load_scale(0.0, &[1.0], &mut |_| {})
-            .map_err(|e| Failure::Compute(format!("reduced static equilibrium: {e}")))?;
-        z.into_iter()
-            .next()
-            .map_or_else(|| red.basis().z_reference(), |e| e.z)
-    } else {
-        red.basis().z_reference()
-    };
-    red.set_load_scale(1.0);
-    if matches!(saved.basis, SavedBasis::Interpolated { .. }) {
-        say!(
-            "initial s = {:.6e} ({})",
-            z0[0],
-            if static_first {
-                "static equilibrium"
-            } else {
-                "the knot nearest to the scene's reference configuration"
-            }
-        );
-    }
-    let nz = red.n_z();
-    let (q0, _) = red.full_state(&z0, &vec![0.0; nz]);
-    // the model's own dynamics: its position solve continues from the
-    // equilibrium it found (a fresh one would start at the reference)
-    let qd0 = red
-        .dynamics_mut()
-        .initial_qd(0.0, &q0)
-        .map_err(|e| Failure::Compute(e.to_string()))?;
-    let zd0 = red.project_velocities(0.0, &z0, &qd0).map_err(compute)?;
-    let phase = crate::interrupt::stoppable();
-    let traj = red.simulate(0.0, &z0, &zd0, opts, |t, _, _| observer(t));
-    phase.finish();
-    let traj = traj.map_err(compute)?;
-    let (q, qd) = traj
-        .z
-        .iter()
-        .zip(&traj.zd)
-        .map(|(z, zd)| red.full_state(z, zd))
-        .unzip();
-    Ok((
-        Response {
-            t: traj.t,
-            q,
-            qd,
-            x: traj.x,
-            stats: traj.stats,
-            wall_time: traj.wall_time,
-            stopped: traj.stopped,
-            chart_switches: vec![],
-        },
-        saved.description,
-    ))
+    let (saved, red) = load_model(mech, model)?;
+    let interpolated = matches!(saved.basis, SavedBasis::Interpolated { .. });
+    Ok((Box::new(red), saved.description, interpolated))
 }
 
 /// The reduced model's eigenfrequencies (F.7) at its static equilibria along
@@ -132,30 +74,24 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
     }
     let pb = count_bar(2 * n as u64, "reduced equilibria, then eigen analyses");
     let start = std::time::Instant::now();
-    let result = (|| {
-        let zs = red
-            .equilibria_over_load_scale(a.t_load, values, &mut |d| pb.set_position(d as u64))
-            .map_err(|e| Failure::Compute(format!("reduced sweep: {e}")))?;
-        let mut freqs = Vec::with_capacity(n);
-        // the equilibria have no partial result; the frequencies do
-        let _phase = crate::interrupt::stoppable();
-        for (i, (l, eq)) in values.iter().zip(&zs).enumerate() {
-            if crate::interrupt::requested() {
-                break;
-            }
-            red.set_load_scale(*l);
-            // the position solve starts at this equilibrium's configuration
-            red.dynamics_mut().kinematics_mut().set_guess(&eq.x);
-            let f = red.frequencies_at_rest(a.t_load, &eq.z).map_err(|e| {
-                Failure::Compute(format!("reduced eigenfrequencies at load scale {l}: {e}"))
-            })?;
-            freqs.push(f.into_iter().take(k).collect::<Vec<f64>>());
-            pb.set_position((n + i + 1) as u64);
+    // the equilibria have no partial result; the frequencies do
+    let mut phase = None;
+    let sweep = red.frequency_sweep(a.t_load, values, k, &mut |d| {
+        pb.set_position(d as u64);
+        if d < n {
+            return Control::Continue;
         }
-        Ok(freqs)
-    })();
+        phase.get_or_insert_with(crate::interrupt::stoppable);
+        if crate::interrupt::requested() {
+            Control::Stop
+        } else {
+            Control::Continue
+        }
+    });
+    drop(phase);
     pb.finish_and_clear();
-    let freqs = result?;
+    let points = sweep.map_err(|e| Failure::Compute(format!("reduced sweep: {e}")))?;
+    let freqs: Vec<Vec<f64>> = points.into_iter().map(|p| p.frequencies).collect();
     let done = freqs.len();
     if done == 0 {
         return Err(Failure::Interrupted(

@@ -84,36 +84,19 @@ pub(crate) fn summary(r: &Response) -> String {
 }
 
 /// Writes `out/outputs.csv` (the scene's outputs, or the DOFs, at each output
-/// time, each from the configuration the run had there: `rows` evaluated
-/// along the run, in the chart of the orientations it had, or else computed
-/// here from each output's configuration), `out/outputs.svg` (the first
+/// time, each from the configuration the run had there: `rows`, from
+/// [`MechanicalModel::simulate_outputs`](flexmb_reduction::MechanicalModel::simulate_outputs)),
+/// `out/outputs.svg` (the first
 /// twelve columns) and `out/path_N.svg` for every node N whose x and y are
 /// outputs.
 pub(crate) fn write_outputs(
-    dy: &mut Dynamics,
-    r: &Response,
-    rows: Option<OutputRows>,
+    dy: &Dynamics,
+    rows: OutputRows,
     comments: &[String],
     out: &Path,
 ) -> Result<(), Failure> {
     std::fs::create_dir_all(out).map_err(|e| io_err(e, out))?;
     let table = OutputTable::new(dy).map_err(|e| Failure::Input(e.to_string()))?;
-    let rows = match rows {
-        Some(rows) => rows,
-        None => {
-            let mut rows = vec![];
-            for (((t, q), qd), x) in r.t.iter().zip(&r.q).zip(&r.qd).zip(&r.x) {
-                let mut row = vec![*t];
-                row.extend(
-                    table
-                        .row(dy, *t, q, qd, x)
-                        .map_err(|e| Failure::Compute(e.to_string()))?,
-                );
-                rows.push(row);
-            }
-            rows
-        }
-    };
     let mut header = vec!["t".to_string()];
     header.extend(table.header.iter().cloned());
     finite::check_table("simulate outputs", &header, &rows)?;

@@ -7,7 +7,10 @@
 //! directory. No row may panic. The rows fail before any long computation,
 //! so the whole table runs in a few seconds.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::fixture;
+
+use std::path::PathBuf;
 use std::process::Command;
 
 /// One bad input.
@@ -28,12 +31,6 @@ struct Catalogue {
     /// The planar straight guidance (17 DOF), the base of every scene.
     planar: String,
     cases: Vec<Case>,
-}
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/scenes")
-        .join(name)
 }
 
 impl Catalogue {

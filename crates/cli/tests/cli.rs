@@ -1,11 +1,9 @@
 //! The command line end to end: a real scene run, exit codes and messages.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
+use common::flexmb;
 
-fn flexmb() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_flexmb"))
-}
+use std::path::Path;
 
 fn fixture(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -197,9 +195,7 @@ const T_LOAD: &str = "0.05";
 const T_END: &str = "0.15";
 
 fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("flexmb-cli-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::temp_dir("cli", name)
 }
 
 /// Runs `flexmb args...` and returns its output.

@@ -2,13 +2,13 @@
 //! `info` checks the outputs, and the failures of `static` and `eig` name
 //! the coordinates and nodes involved.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::Command;
 
 fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("flexmb-culprit-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::temp_dir("culprit", name)
 }
 
 /// Writes a planar scene: a clamped beam A–B, a truss B–S along x and a

@@ -3,14 +3,11 @@
 //! Checked against beam theory at small stroke and against `flexmb static`
 //! under that force, which must move S by the swept amount.
 
+mod common;
+use common::fixture;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/scenes")
-        .join(name)
-}
 
 fn temp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("flexmb-hold-{name}-{}", std::process::id()));

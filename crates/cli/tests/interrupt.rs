@@ -3,6 +3,9 @@
 //! and the exit code is 130 or 143; a second signal exits at once; a closed
 //! standard output is no panic.
 
+mod common;
+use common::fixture;
+
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
@@ -16,12 +19,6 @@ const EXIT_WITHIN: Duration = Duration::from_secs(1);
 
 /// What the issue asks: the computation stops within 0.2 s of the signal.
 const STOP_WITHIN_MS: f64 = 200.0;
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/scenes")
-        .join(name)
-}
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("flexmb-interrupt-{name}-{}", std::process::id()));

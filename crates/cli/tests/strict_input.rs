@@ -2,13 +2,13 @@
 //! each is refused with the culprit named, and a result that is not finite is
 //! an error (exit code 1), never NaN printed with exit code 0.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("flexmb-strict-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::temp_dir("strict", name)
 }
 
 fn run(args: &[&str]) -> Output {

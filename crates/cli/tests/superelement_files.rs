@@ -3,6 +3,8 @@
 //! input error; build errors used to give 1) and names the file at fault.
 //! The files are Matrix Market exports of a small built-in hex20 bar.
 
+mod common;
+
 use flexmb_element::Material;
 use flexmb_superelement::parts;
 use flexmb_superelement::readers::{write_matrix_market, write_nodes};
@@ -14,9 +16,7 @@ const BY: f64 = 0.01;
 const BZ: f64 = 0.006;
 
 fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("flexmb-sefiles-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::temp_dir("sefiles", name)
 }
 
 /// Writes K, M (Matrix Market) and the node file of a steel bar with `n`

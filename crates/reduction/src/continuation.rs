@@ -7,7 +7,7 @@
 //! reduced one) and in how one equilibrium is solved, so that the CLI and the
 //! benchmark harness walk the same path.
 
-use crate::{ReducedModel, ReductionError};
+use crate::ReductionError;
 
 /// The substep counts tried by [`continue_load_scale`], in order.
 pub const SUBSTEPS: [usize; 7] = [1, 2, 4, 8, 16, 32, 64];
@@ -83,64 +83,6 @@ pub fn load_scale_path<S: Clone>(
         }
     }
     Ok(out.into_iter().flatten().collect())
-}
-
-/// A reduced static equilibrium: the reduced coordinates and the unreduced
-/// nodal coordinates x = F(G(z)) the solver converged to.
-#[derive(Clone, Debug)]
-pub struct ReducedEquilibrium {
-    /// The reduced coordinates z.
-    pub z: Vec<f64>,
-    /// The configuration x; start position solves at z here (a solve from a
-    /// far-away configuration, e.g. another end of the path, can land on
-    /// another branch).
-    pub x: Vec<f64>,
-}
-
-impl ReducedModel {
-    /// The reduced static equilibria at the load scales `lambdas` (loads at
-    /// time `t`, gravity unscaled, any order): the equilibrium without the
-    /// scene's loads from the basis's reference coordinates
-    /// ([`Basis::z_reference`](crate::Basis::z_reference)), then
-    /// [`load_scale_path`] with [`static_equilibrium`](Self::static_equilibrium)
-    /// (all reduced coordinates free), each position solve starting at the
-    /// configuration of the equilibrium it continues from. `done(k)` reports
-    /// progress. The load scale is left at the last value solved; set it
-    /// (and the kinematics' guess to the state's x) before evaluating at one
-    /// of the returned states.
-    pub fn equilibria_over_load_scale(
-        &mut self,
-        t: f64,
-        lambdas: &[f64],
-        done: &mut dyn FnMut(usize),
-    ) -> Result<Vec<ReducedEquilibrium>, ReductionError> {
-        let z_ref = self.basis().z_reference();
-        self.set_load_scale(0.0);
-        let z0 =
-            self.static_equilibrium(t, &z_ref, &[])
-                .map_err(|e| ReductionError::NoEquilibrium {
-                    lambda: 0.0,
-                    from: 0.0,
-                    substeps: 1,
-                    message: format!("without the scene's loads (gravity only): {e}"),
-                })?;
-        let at_zero = ReducedEquilibrium {
-            z: z0,
-            x: self.dynamics().kinematics().x().to_vec(),
-        };
-        let mut solve = |from: &ReducedEquilibrium, l: f64| -> Result<ReducedEquilibrium, String> {
-            self.set_load_scale(l);
-            self.dynamics_mut().kinematics_mut().set_guess(&from.x);
-            let z = self
-                .static_equilibrium(t, &from.z, &[])
-                .map_err(|e| e.to_string())?;
-            Ok(ReducedEquilibrium {
-                z,
-                x: self.dynamics().kinematics().x().to_vec(),
-            })
-        };
-        load_scale_path(&at_zero, lambdas, &mut solve, done)
-    }
 }
 
 #[cfg(test)]

@@ -15,7 +15,10 @@
 //! eigenvectors, the per-mode SVD (6.19)–(6.21), the path eigenvectors of
 //! chapter 7 (7.3)–(7.11), reduced statics with load-scale continuation
 //! ([`load_scale_path`]), the reduced linearization (F.5) with its rest form
-//! (F.7), and saving and loading reduced models ([`SavedModel`]). The
+//! (F.7), and saving and loading reduced models ([`SavedModel`]).
+//! [`MechanicalModel`] gives the unreduced [`Dynamics`](flexmb_dynamics::Dynamics)
+//! and the [`ReducedModel`] one interface (statics, rest linearization,
+//! eigenfrequencies, load sweeps, simulation). The
 //! `flexmb reduce` command builds these models from a scene (docs/cli.md).
 //!
 //! ```
@@ -36,6 +39,7 @@
 mod basis;
 mod continuation;
 mod ibm;
+mod mechanical;
 mod model;
 mod msi;
 mod path;
@@ -46,8 +50,9 @@ pub use basis::{
     fixed_basis_frequencies, modal_basis, per_mode_svd_basis, svd_modal_basis, Basis, FixedBasis,
     PerModeSvd, SvdModal, FINAL_SVD_THRESHOLD, SVD_THRESHOLD,
 };
-pub use continuation::{continue_load_scale, load_scale_path, ReducedEquilibrium, SUBSTEPS};
+pub use continuation::{continue_load_scale, load_scale_path, SUBSTEPS};
 pub use ibm::{interpolated_basis_from_sweep, InterpolatedBasis, Knots, SubspaceInterpolation};
+pub use mechanical::{Equilibrium, MechanicalModel, ModelTrajectory, StateObserver, SweepPoint};
 pub use model::{ReducedLinearization, ReducedModel, ReducedTrajectory};
 pub use msi::{largest_principal_angle, mac_sorted, modal_subspace_interpolation, orthonormalize};
 pub use path::{

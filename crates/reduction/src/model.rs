@@ -225,8 +225,10 @@ impl ReducedModel {
     /// values in `z0`. Converged when ‖Δz‖∞ ≤ 1e-10 (1 + ‖z‖∞); fails after 30
     /// iterations with the remaining out-of-balance. Continuation in a load
     /// parameter is the caller's ([`set_load_scale`](Self::set_load_scale)
-    /// in small steps, each starting from the previous equilibrium).
-    pub fn static_equilibrium(
+    /// in small steps, each starting from the previous equilibrium). The
+    /// model-independent form, with the signature of the unreduced solver,
+    /// is [`MechanicalModel::static_equilibrium`](crate::MechanicalModel::static_equilibrium).
+    pub fn newton_equilibrium(
         &mut self,
         t: f64,
         z0: &[f64],

@@ -126,7 +126,7 @@ fn at_rest_in_equilibrium_the_linearization_is_the_rest_form() {
     let mut model = ReducedModel::new(mech.clone(), Box::new(b));
     let z0 = model.basis().z_reference();
     let z = model
-        .static_equilibrium(0.0, &[z0[0] + 0.02, 0.0, 0.0], &[0])
+        .newton_equilibrium(0.0, &[z0[0] + 0.02, 0.0, 0.0], &[0])
         .unwrap();
     let lin = model.linearize(0.0, &z, &[0.0; 3], &[0.0; 3]).unwrap();
     let (mz, kz) = model.linearize_at_rest(0.0, &z).unwrap();
