@@ -42,7 +42,6 @@ mod nodal_eom;
 mod outputs;
 mod reactions;
 mod simulate;
-mod skyline;
 mod statics;
 
 /// A scene of `fixtures/scenes`, for the unit tests.

@@ -8,11 +8,16 @@
 //!   when faer does not converge, with rank and null spaces.
 //! - [`lu`]: a dense LU factorization with partial pivoting in reused memory,
 //!   with pivot-ratio singularity detection (integrators, kinematics, statics).
+//! - [`skyline`]: a symmetric positive-definite matrix in profile storage, its
+//!   Cholesky factorization in place and a reverse Cuthill–McKee ordering (the
+//!   mass matrix of the nodal equations of motion).
 //!
-//! A failed decomposition is a typed error ([`SvdError`], [`LuError`]); the
-//! physics crates wrap it as the source of their own errors.
+//! A failed decomposition is a typed error ([`SvdError`], [`LuError`],
+//! [`skyline::NotPositiveDefinite`]); the physics crates wrap it as the
+//! source of their own errors.
 
 pub mod lu;
+pub mod skyline;
 pub mod svd;
 
 pub use lu::{DenseLu, LuError, SINGULAR_PIVOT_RATIO};
