@@ -11,14 +11,26 @@
 //! - [`skyline`]: a symmetric positive-definite matrix in profile storage, its
 //!   Cholesky factorization in place and a reverse Cuthill–McKee ordering (the
 //!   mass matrix of the nodal equations of motion).
+//! - [`eigen`]: the dense generalized symmetric-definite eigensolver
+//!   `K v = λ M v` (Cholesky of K or M, transformation, `self_adjoint_eigen`,
+//!   back-substitution, Rayleigh quotients; modes, buckling, Rayleigh–Ritz).
+//! - [`sparse_cholesky`]: a supernodal sparse Cholesky factorization and, with
+//!   it as a shift-invert operator, the lowest eigenpairs of a large sparse
+//!   pencil (Craig–Bampton reduction of solid models).
 //!
 //! A failed decomposition is a typed error ([`SvdError`], [`LuError`],
-//! [`skyline::NotPositiveDefinite`]); the physics crates wrap it as the
-//! source of their own errors.
+//! [`skyline::NotPositiveDefinite`], [`EigenError`], [`CholeskyError`]); the
+//! physics crates wrap it as the source of their own errors.
 
+pub mod eigen;
 pub mod lu;
 pub mod skyline;
+pub mod sparse_cholesky;
 pub mod svd;
 
+pub use eigen::{
+    generalized_eigen, generalized_eigenvalues, Definite, EigenError, GeneralizedEigen, Member,
+};
 pub use lu::{DenseLu, LuError, SINGULAR_PIVOT_RATIO};
+pub use sparse_cholesky::{lowest_eigenpairs, CholeskyError, SparseCholesky};
 pub use svd::{singular_values, svd, thin_svd, Svd, SvdError, SvdMethod};
