@@ -4,7 +4,7 @@
 //! matrix, so that each algorithm exists once (`ARCHITECTURE.md`). Small
 //! fixed-size element math stays on nalgebra in `flexmb-element`.
 //!
-//! - [`svd`]: singular value decompositions that fall back to other methods
+//! - [`svd`](mod@svd): singular value decompositions that fall back to other methods
 //!   when faer does not converge, with rank and null spaces.
 //! - [`lu`]: a dense LU factorization with partial pivoting in reused memory,
 //!   with pivot-ratio singularity detection (integrators, kinematics, statics).
