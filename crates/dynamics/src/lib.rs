@@ -48,7 +48,6 @@ mod nodal_eom;
 mod outputs;
 mod reactions;
 mod simulate;
-mod skyline;
 mod statics;
 
 /// A scene of `fixtures/scenes`, for the unit tests.
@@ -109,6 +108,9 @@ pub enum DynamicsError {
         /// The degrees of freedom of the estimated null vectors of the
         /// tangent ([`null_space_dofs`]).
         unrestrained: Vec<String>,
+        /// The failed factorization of the tangent over the free DOFs.
+        #[source]
+        source: flexmb_linalg::LuError,
     },
     /// Statics did not converge.
     #[error("static equilibrium not found beyond load factor {load_factor}: {cause}")]

@@ -37,13 +37,13 @@
 //! so f − Mx(ẍ_u − ẋ_g) − h needs one inertia-force call per element and no
 //! separate gravity pass.
 
-use crate::skyline::{reverse_cuthill_mckee, Skyline};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{matmul as tri_matmul, BlockStructure};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use flexmb_kinematics::Kinematics;
+use flexmb_linalg::skyline::{reverse_cuthill_mckee, Skyline};
 use flexmb_model::{Coordinate, ERole, Mechanism, XRole};
 
 /// Why the nodal solve could not produce q̈ (the caller then falls back to

@@ -4,7 +4,7 @@
 
 use crate::{Dynamics, DynamicsError};
 use faer::Mat;
-use flexmb_kinematics::DenseLu;
+use flexmb_linalg::{DenseLu, LuError};
 use flexmb_model::{Coordinate, Load};
 use flexmb_rotation::EulerParameters;
 use std::sync::atomic::AtomicBool;
@@ -327,11 +327,12 @@ impl Dynamics {
         let (g, tan) = self.static_tangent(t, q)?;
         let tf = Mat::from_fn(free.len(), free.len(), |a, b| tan[(free[a], free[b])]);
         let mut lu = DenseLu::default();
-        if !lu.factor(tf.as_ref()) {
+        if let Err(source) = lu.factor(tf.as_ref()) {
             // named once, when the solve gives up (see `unrestrained_at`)
             return Err(DynamicsError::SingularTangent {
                 load_factor,
                 unrestrained: vec![],
+                source,
             });
         }
         let coupling = held
@@ -381,7 +382,7 @@ impl Dynamics {
                 *r -= c * d;
             }
         }
-        f.lu.solve_vec(&mut rhs, &mut Mat::zeros(nf, 1));
+        f.lu.solve_vec_with(&mut rhs, &mut vec![0.0; nf]);
         if rhs.iter().all(|v| v.is_finite()) {
             for (i, d) in free.iter().zip(&rhs) {
                 q[*i] += d;
@@ -400,6 +401,7 @@ impl Dynamics {
         q: &[f64],
         free: &[usize],
         load_factor: f64,
+        source: LuError,
     ) -> DynamicsError {
         let unrestrained = match self.static_tangent(t, q) {
             Ok((_, tan)) => {
@@ -411,6 +413,7 @@ impl Dynamics {
         DynamicsError::SingularTangent {
             load_factor,
             unrestrained,
+            source,
         }
     }
 
@@ -605,7 +608,9 @@ impl Dynamics {
                     break;
                 };
                 let mut dq: Vec<f64> = free.iter().map(|i| -g[*i]).collect();
-                factor.lu.solve_vec(&mut dq, &mut Mat::zeros(free.len(), 1));
+                factor
+                    .lu
+                    .solve_vec_with(&mut dq, &mut vec![0.0; free.len()]);
                 let dn = dq.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 // (NaN included: a non-finite chord step is rejected too)
                 let contracts = dn <= CHORD_CONTRACTION * prev_dn;
@@ -644,13 +649,17 @@ impl Dynamics {
                 dl *= 0.5;
                 if dl < opts.min_increment {
                     if let (
-                        Some(DynamicsError::SingularTangent { load_factor, .. }),
+                        Some(DynamicsError::SingularTangent {
+                            load_factor,
+                            source,
+                            ..
+                        }),
                         Some((qs, lf)),
                     ) = (&last_err, &singular_at)
                     {
-                        let load_factor = *load_factor;
+                        let (load_factor, source) = (*load_factor, *source);
                         self.load_factor = *lf;
-                        last_err = Some(self.unrestrained_at(t, qs, &free, load_factor));
+                        last_err = Some(self.unrestrained_at(t, qs, &free, load_factor, source));
                         self.kin.set_guess(&x_good);
                         let _ = self.kin.solve(&q, t);
                     }

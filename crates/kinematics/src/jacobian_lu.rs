@@ -24,20 +24,18 @@ use faer::sparse::linalg::lu::simplicial::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, MatMut, Par};
 
-use crate::lu::{DenseLu, SINGULAR_PIVOT_RATIO};
+use flexmb_linalg::{DenseLu, SINGULAR_PIVOT_RATIO};
 
 /// Jacobians with at most this many rows are factorized densely.
-pub const DENSE_UP_TO: usize = 200;
+pub(crate) const DENSE_UP_TO: usize = 200;
 
 /// The dense factorization of a small Jacobian.
 struct DenseFactor {
-    matrix: Mat<f64>,
     lu: DenseLu,
-    buf: Mat<f64>,
 }
 
 /// The factorized Jacobian, with its pattern and all work memory.
-pub struct JacobianLu {
+pub(crate) struct JacobianLu {
     n: usize,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
@@ -54,7 +52,7 @@ pub struct JacobianLu {
     dense: Option<DenseFactor>,
     factored: bool,
     /// Smallest |Uᵢᵢ| / largest |Uᵢᵢ| of the last factorization (0 when it failed).
-    pub pivot_ratio: f64,
+    pub(crate) pivot_ratio: f64,
 }
 
 impl std::fmt::Debug for JacobianLu {
@@ -69,14 +67,10 @@ impl std::fmt::Debug for JacobianLu {
 
 impl JacobianLu {
     /// Sets up the pattern of an n × n matrix from its (row, column) entries
-    /// (duplicates allowed) and returns, for each entry in the given order,
+    /// (duplicates allowed), to be factorized densely when n ≤ `dense_up_to`
+    /// (see [`DENSE_UP_TO`]), and returns, for each entry in the given order,
     /// its position in [`values_mut`](Self::values_mut).
-    pub fn new(n: usize, entries: &[(usize, usize)]) -> (Self, Vec<usize>) {
-        Self::with_dense_limit(n, entries, DENSE_UP_TO)
-    }
-
-    /// As [`new`](Self::new), factorizing densely when n ≤ `dense_up_to`.
-    pub fn with_dense_limit(
+    pub(crate) fn with_dense_limit(
         n: usize,
         entries: &[(usize, usize)],
         dense_up_to: usize,
@@ -137,9 +131,7 @@ impl JacobianLu {
             mem: MemBuffer::new(Self::scratch(n, rhs_capacity)),
             rhs_capacity,
             dense: (n <= dense_up_to).then(|| DenseFactor {
-                matrix: Mat::zeros(n, n),
-                lu: DenseLu::default(),
-                buf: Mat::zeros(n, 1),
+                lu: DenseLu::new(n),
             }),
             factored: false,
             pivot_ratio: 0.0,
@@ -154,19 +146,14 @@ impl JacobianLu {
         ])
     }
 
-    /// The values, to be filled (in the order of [`new`](Self::new)'s positions)
+    /// The values, to be filled (in the order of [`with_dense_limit`](Self::with_dense_limit)'s positions)
     /// before [`factor`](Self::factor).
-    pub fn values_mut(&mut self) -> &mut [f64] {
+    pub(crate) fn values_mut(&mut self) -> &mut [f64] {
         &mut self.values
     }
 
-    /// Number of stored entries of the pattern.
-    pub fn nnz(&self) -> usize {
-        self.row_idx.len()
-    }
-
     /// The matrix as a dense one (for diagnostics of a singular Jacobian).
-    pub fn to_dense(&self) -> Mat<f64> {
+    pub(crate) fn to_dense(&self) -> Mat<f64> {
         let mut m = Mat::zeros(self.n, self.n);
         for c in 0..self.n {
             for p in self.col_ptr[c]..self.col_ptr[c + 1] {
@@ -178,7 +165,7 @@ impl JacobianLu {
 
     /// Factorizes the current values; false if the matrix is (numerically)
     /// singular or not finite (pivot ratio below `SINGULAR_PIVOT_RATIO`).
-    pub fn factor(&mut self) -> bool {
+    pub(crate) fn factor(&mut self) -> bool {
         self.factored = false;
         self.pivot_ratio = 0.0;
         let n = self.n;
@@ -191,14 +178,25 @@ impl JacobianLu {
             return false;
         }
         if let Some(d) = &mut self.dense {
-            d.matrix.fill(0.0);
+            let mut m = d.lu.matrix_mut();
+            m.fill(0.0);
             for c in 0..n {
                 for p in self.col_ptr[c]..self.col_ptr[c + 1] {
-                    d.matrix[(self.row_idx[p], c)] += self.values[p];
+                    m[(self.row_idx[p], c)] += self.values[p];
                 }
             }
-            self.factored = d.lu.factor(d.matrix.as_ref());
-            self.pivot_ratio = d.lu.pivot_ratio;
+            // a failure is reported by the pivot ratio (0 when a pivot is zero)
+            self.factored = match d.lu.factor_in_place() {
+                Ok(ratio) => {
+                    self.pivot_ratio = ratio;
+                    true
+                }
+                Err(flexmb_linalg::LuError::Singular { pivot_ratio, .. }) => {
+                    self.pivot_ratio = pivot_ratio;
+                    false
+                }
+                Err(_) => false,
+            };
             return self.factored;
         }
         let a = SparseColMatRef::new(
@@ -245,7 +243,7 @@ impl JacobianLu {
     /// Solves J X = B in place (B: n × k). Before a successful
     /// [`factor`](Self::factor) (or after a failed one) B becomes NaN, so a
     /// solve with a singular J can never pass for a result.
-    pub fn solve_in_place(&mut self, mut b: MatMut<'_, f64>) {
+    pub(crate) fn solve_in_place(&mut self, mut b: MatMut<'_, f64>) {
         if self.n == 0 || b.ncols() == 0 {
             return;
         }
@@ -270,7 +268,7 @@ impl JacobianLu {
     }
 
     /// Solves Jᵀ X = B in place (NaN without a successful factorization).
-    pub fn solve_transpose_in_place(&mut self, mut b: MatMut<'_, f64>) {
+    pub(crate) fn solve_transpose_in_place(&mut self, mut b: MatMut<'_, f64>) {
         if self.n == 0 || b.ncols() == 0 {
             return;
         }
@@ -295,9 +293,9 @@ impl JacobianLu {
     }
 
     /// Solves J x = b for one vector in place.
-    pub fn solve_vec(&mut self, b: &mut [f64]) {
+    pub(crate) fn solve_vec(&mut self, b: &mut [f64]) {
         if let (Some(d), true) = (&mut self.dense, self.factored) {
-            d.lu.solve_vec(b, &mut d.buf);
+            d.lu.solve_vec(b);
             return;
         }
         let n = b.len();
@@ -305,9 +303,9 @@ impl JacobianLu {
     }
 
     /// Solves Jᵀ x = b for one vector in place.
-    pub fn solve_transpose_vec(&mut self, b: &mut [f64]) {
+    pub(crate) fn solve_transpose_vec(&mut self, b: &mut [f64]) {
         if let (Some(d), true) = (&mut self.dense, self.factored) {
-            d.lu.solve_transpose_vec(b, &mut d.buf);
+            d.lu.solve_transpose_vec(b);
             return;
         }
         let n = b.len();

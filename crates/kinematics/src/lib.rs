@@ -43,11 +43,9 @@
 #![warn(missing_docs)]
 
 mod jacobian_lu;
-mod lu;
 mod null_space;
 
-pub use jacobian_lu::{JacobianLu, DENSE_UP_TO};
-pub use lu::DenseLu;
+use jacobian_lu::{JacobianLu, DENSE_UP_TO};
 pub use null_space::null_vectors;
 
 use faer::Mat;
@@ -261,7 +259,9 @@ const REFRESH_BUDGET: usize = 6;
 const NO_ENTRY: usize = usize::MAX;
 
 impl Kinematics {
-    /// Prepares the kinematics of a mechanism, starting from its reference configuration.
+    /// Prepares the kinematics of a mechanism, starting from its reference
+    /// configuration. The kinematic Jacobian is factorized densely up to 200
+    /// rows and sparsely above.
     pub fn new(mech: Arc<Mechanism>) -> Self {
         Self::with_dense_limit(mech, DENSE_UP_TO)
     }

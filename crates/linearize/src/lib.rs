@@ -4,6 +4,10 @@
 //! nodal coordinates, the MAC matrix and MAC mode tracking, and sweeps of the
 //! eigenfrequencies along a load, a coordinate or a path, in parallel.
 //!
+//! The generalized symmetric-definite eigensolver behind the undamped modes
+//! and buckling is `flexmb_linalg::generalized_eigen` (one copy, shared with
+//! the superelement builder).
+//!
 //! ```
 //! use flexmb_model::Scene;
 //! use flexmb_dynamics::Dynamics;

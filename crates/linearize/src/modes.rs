@@ -6,6 +6,7 @@ use crate::LinearizeError;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use flexmb_dynamics::Linearization;
+use flexmb_linalg::{generalized_eigen, generalized_eigenvalues, Definite, EigenError, Member};
 
 /// Undamped modes, sorted by increasing ω².
 #[derive(Clone, Debug)]
@@ -39,105 +40,49 @@ fn sym(a: &Mat<f64>) -> Mat<f64> {
     Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]))
 }
 
-/// L⁻¹ A L⁻ᵀ (symmetrized) for a lower-triangular Cholesky factor L.
-fn congruence(l: &Mat<f64>, a: &Mat<f64>) -> Mat<f64> {
-    let mut b = a.clone();
-    faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-        l.as_ref(),
-        b.as_mut(),
-        faer::Par::Seq,
-    );
-    let mut bt = b.transpose().to_owned();
-    faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-        l.as_ref(),
-        bt.as_mut(),
-        faer::Par::Seq,
-    );
-    sym(&bt)
-}
-
-/// v = L⁻ᵀ y.
-fn back_substitute(l: &Mat<f64>, mut y: Mat<f64>) -> Mat<f64> {
-    faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-        l.transpose(),
-        y.as_mut(),
-        faer::Par::Seq,
-    );
-    y
+/// The analysis error of a failed eigenproblem: `names` says what K and M of
+/// the pencil are, `not_positive` is the error when the member that must be
+/// positive definite is not (its culprit is named later, by [`named`]).
+fn eigen_error(
+    e: EigenError,
+    names: [&'static str; 2],
+    not_positive: LinearizeError,
+) -> LinearizeError {
+    match e {
+        EigenError::Dimension { .. } | EigenError::TooMany { .. } => {
+            LinearizeError::Dimension(e.to_string())
+        }
+        EigenError::NonFinite { matrix, .. } => LinearizeError::NonFinite(match matrix {
+            Member::K => names[0],
+            Member::M => names[1],
+        }),
+        EigenError::NotPositiveDefinite { .. } => not_positive,
+        _ => LinearizeError::NoConvergence { at: String::new() },
+    }
 }
 
 /// Solves the generalized symmetric-definite problem K v = λ M v for the `k`
 /// lowest λ (all when `k` ≥ n). M must be positive definite. The problem is
 /// transformed with the Cholesky factor of K when K is positive definite (which
 /// keeps the low eigenvalues accurate when λ spans many decades), else with
-/// that of M; the eigenvalues are then refined by Rayleigh quotients.
+/// that of M; the eigenvalues are then refined by Rayleigh quotients
+/// ([`flexmb_linalg::generalized_eigen`]).
 pub fn generalized_symmetric(
     k: &Mat<f64>,
     m: &Mat<f64>,
     count: usize,
 ) -> Result<Modes, LinearizeError> {
-    let n = k.nrows();
-    if n == 0 {
-        return Ok(Modes {
-            omega2: vec![],
-            vectors: Mat::zeros(0, 0),
-        });
-    }
-    if k.ncols() != n || m.nrows() != n || m.ncols() != n {
-        return Err(LinearizeError::Dimension(format!(
-            "K is {}×{}, M is {}×{}",
-            k.nrows(),
-            k.ncols(),
-            m.nrows(),
-            m.ncols()
-        )));
-    }
-    if k.col_iter()
-        .flat_map(|c| c.iter().copied().collect::<Vec<_>>())
-        .any(|v| !v.is_finite())
-    {
-        return Err(LinearizeError::NonFinite("stiffness matrix"));
-    }
-    let (ks, ms) = (sym(k), sym(m));
-    let mllt = ms
-        .llt(Side::Lower)
-        .map_err(|_| LinearizeError::MassNotPositive { dofs: vec![] })?;
-    let count = count.min(n);
-    let vectors: Mat<f64> = match ks.llt(Side::Lower) {
-        Ok(kllt) => {
-            // K = Lk Lkᵀ: Lk⁻¹ M Lk⁻ᵀ y = (1/λ) y, v = Lk⁻ᵀ y; largest 1/λ first
-            let l = kllt.L().to_owned();
-            let evd = congruence(&l, &ms)
-                .self_adjoint_eigen(Side::Lower)
-                .map_err(|_| LinearizeError::NoConvergence { at: String::new() })?;
-            let u = evd.U();
-            back_substitute(&l, Mat::from_fn(n, count, |i, j| u[(i, n - 1 - j)]))
-        }
-        Err(_) => {
-            // M = Lm Lmᵀ: Lm⁻¹ K Lm⁻ᵀ y = λ y, v = Lm⁻ᵀ y; smallest λ first
-            let l = mllt.L().to_owned();
-            let evd = congruence(&l, &ks)
-                .self_adjoint_eigen(Side::Lower)
-                .map_err(|_| LinearizeError::NoConvergence { at: String::new() })?;
-            let u = evd.U();
-            back_substitute(&l, Mat::from_fn(n, count, |i, j| u[(i, j)]))
-        }
-    };
-    // mass-normalize and Rayleigh quotients
-    let kv = &ks * &vectors;
-    let mv = &ms * &vectors;
-    let mut pairs: Vec<(f64, Vec<f64>)> = (0..count)
-        .map(|j| {
-            let vm: f64 = (0..n).map(|i| vectors[(i, j)] * mv[(i, j)]).sum();
-            let vk: f64 = (0..n).map(|i| vectors[(i, j)] * kv[(i, j)]).sum();
-            let s = 1.0 / vm.sqrt();
-            (vk / vm, (0..n).map(|i| vectors[(i, j)] * s).collect())
-        })
-        .collect();
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let omega2 = pairs.iter().map(|p| p.0).collect();
-    let vectors = Mat::from_fn(n, count, |i, j| pairs[j].1[i]);
-    Ok(Modes { omega2, vectors })
+    let e = generalized_eigen(k.as_ref(), m.as_ref(), count, Definite::Mass).map_err(|e| {
+        eigen_error(
+            e,
+            ["stiffness matrix", "mass matrix"],
+            LinearizeError::MassNotPositive { dofs: vec![] },
+        )
+    })?;
+    Ok(Modes {
+        omega2: e.values,
+        vectors: e.vectors,
+    })
 }
 
 /// Undamped modes of a linearization: (K + G + N) v = ω² M v with the
@@ -266,10 +211,6 @@ pub fn buckling_factors(lin: &Linearization, count: usize) -> Result<Vec<f64>, L
 /// [`buckling_factors`] without naming the culprit of a failure.
 fn buckling_eigenvalues(lin: &Linearization, count: usize) -> Result<Vec<f64>, LinearizeError> {
     let n = lin.k.nrows();
-    let kllt = sym(&lin.k)
-        .llt(Side::Lower)
-        .map_err(|_| LinearizeError::StiffnessNotPositive { dofs: vec![] })?;
-    let l = kllt.L().to_owned();
     let mut g = sym(&lin.g);
     g += &sym(&lin.n);
     for v in g.col_iter_mut() {
@@ -277,10 +218,15 @@ fn buckling_eigenvalues(lin: &Linearization, count: usize) -> Result<Vec<f64>, L
             *e = -*e;
         }
     }
-    let vals = congruence(&l, &g)
-        .self_adjoint_eigenvalues(Side::Lower)
-        .map_err(|_| LinearizeError::NoConvergence { at: String::new() })?;
-    // eigenvalues ν of Lk⁻¹(−G)Lk⁻ᵀ: μ = 1/ν for ν > 0
+    // −G v = ν K v
+    let vals = generalized_eigenvalues(g.as_ref(), lin.k.as_ref()).map_err(|e| {
+        eigen_error(
+            e,
+            ["geometric stiffness", "stiffness matrix"],
+            LinearizeError::StiffnessNotPositive { dofs: vec![] },
+        )
+    })?;
+    // μ = 1/ν for ν > 0
     let mut mu: Vec<f64> = vals
         .iter()
         .filter(|v| **v > 1e-14 * vals.iter().fold(0.0f64, |m, x| m.max(x.abs())))

@@ -202,5 +202,8 @@ pub enum OdeError {
         what: &'static str,
         /// Time of the failure.
         t: f64,
+        /// The failed factorization.
+        #[source]
+        source: flexmb_linalg::LuError,
     },
 }

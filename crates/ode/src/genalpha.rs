@@ -121,8 +121,8 @@ use crate::common::{
     spacing, wrap_rhs_error, Control, Output, Stats, Status, Tolerance,
 };
 use crate::error::OdeError;
-use crate::lu::DenseLu;
 use crate::system::SecondOrderSystem;
+use flexmb_linalg::{DenseLu, LuError};
 
 /// Options of [`GeneralizedAlpha`].
 #[derive(Clone, Debug, PartialEq)]
@@ -440,6 +440,8 @@ struct Linear {
     lu: DenseLu,
     /// Step size for which `lu` holds `S`, if it is valid.
     h_lu: Option<f64>,
+    /// Why the last factorization of `S` failed.
+    lu_error: Option<LuError>,
     /// Whether the tangent was evaluated at the start of the current step.
     fresh: bool,
     /// The tangent should be re-evaluated before the next step.
@@ -546,8 +548,11 @@ impl GeneralizedAlpha {
             mass: Mat::zeros(n, n),
             damping: Mat::zeros(n, n),
             stiffness: Mat::zeros(n, n),
-            lu: DenseLu::new(n),
+            // only an exactly zero pivot is singular: the integrator's own
+            // error control judges an ill-conditioned but invertible matrix
+            lu: DenseLu::new(n).with_singular_pivot_ratio(0.0),
             h_lu: None,
+            lu_error: None,
             fresh: false,
             stale: true,
         };
@@ -574,14 +579,18 @@ impl GeneralizedAlpha {
                 eval_tangent(sys, t, &x0.q, &x0.qd, zeros, &mut lin, &mut stats)?;
                 lin.lu.matrix_mut().copy_from(&lin.mass);
                 stats.lu_decompositions += 1;
-                if !lin.lu.factor() {
-                    return Err(OdeError::SingularMatrix { what: "mass", t });
+                if let Err(source) = lin.lu.factor_in_place() {
+                    return Err(OdeError::SingularMatrix {
+                        what: "mass",
+                        t,
+                        source,
+                    });
                 }
                 eval_residual(sys, t, &x0.q, &x0.qd, zeros, &mut r, &mut stats)?;
                 for (a, ri) in x0.qdd.iter_mut().zip(&r) {
                     *a = -ri;
                 }
-                lin.lu.solve_in_place(&mut x0.qdd);
+                lin.lu.solve_vec(&mut x0.qdd);
                 if let Some(index) = first_non_finite(&x0.qdd) {
                     return Err(OdeError::NonFiniteState { t, index });
                 }
@@ -652,10 +661,12 @@ impl GeneralizedAlpha {
                 if lin.h_lu != Some(h) {
                     build_iteration_matrix(&mut lin, &par, h);
                     stats.lu_decompositions += 1;
-                    if lin.lu.factor() {
-                        lin.h_lu = Some(h);
-                    } else {
-                        lin.h_lu = None;
+                    match lin.lu.factor_in_place() {
+                        Ok(_) => lin.h_lu = Some(h),
+                        Err(e) => {
+                            lin.h_lu = None;
+                            lin.lu_error = Some(e);
+                        }
                     }
                 }
                 let result = if lin.h_lu.is_some() {
@@ -707,6 +718,12 @@ impl GeneralizedAlpha {
                                 OdeError::SingularMatrix {
                                     what: "iteration",
                                     t,
+                                    source: lin.lu_error.unwrap_or(LuError::Singular {
+                                        n: x0.q.len(),
+                                        index: 0,
+                                        pivot_ratio: 0.0,
+                                        threshold: 0.0,
+                                    }),
                                 }
                             } else {
                                 OdeError::NewtonFailed { t, h }
@@ -902,7 +919,7 @@ fn filter(lin: &mut Linear, par: &AlphaParameters, h: f64, e: &mut [f64], tmp: &
             }
         }
     }
-    lin.lu.solve_in_place(tmp);
+    lin.lu.solve_vec(tmp);
     e.copy_from_slice(tmp);
 }
 
@@ -973,7 +990,7 @@ fn newton<S: SecondOrderSystem + ?Sized>(
         for (d, ri) in dq.iter_mut().zip(r.iter()) {
             *d = -ri;
         }
-        lin.lu.solve_in_place(dq);
+        lin.lu.solve_vec(dq);
         stats.newton_iterations += 1;
         if first_non_finite(dq).is_some() {
             return Ok(Newton::Failed);

@@ -11,7 +11,9 @@
 //!   DE/STEP/INTRP;
 //! * [`GeneralizedAlpha`]: the implicit generalized-α method of Chung &
 //!   Hulbert for stiff second-order systems `g(t, q, q̇, q̈) = 0`, with
-//!   modified Newton iterations, LU reuse and local error control.
+//!   modified Newton iterations, LU reuse (`flexmb_linalg::DenseLu`, one
+//!   factorization kept while the step size and tangent are) and local error
+//!   control.
 //!
 //! First-order problems implement [`OdeSystem`]; second-order problems in
 //! residual form implement [`SecondOrderSystem`] and can be handed to the
@@ -65,7 +67,6 @@ mod common;
 pub mod dopri5;
 mod error;
 pub mod genalpha;
-mod lu;
 mod system;
 
 pub use adams::{Adams, AdamsOptions};

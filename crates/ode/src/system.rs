@@ -5,7 +5,7 @@ use faer::Mat;
 
 use crate::common::Control;
 use crate::error::RhsError;
-use crate::lu::DenseLu;
+use flexmb_linalg::DenseLu;
 
 /// A first-order system of ordinary differential equations `y' = f(t, y)`.
 ///
@@ -179,7 +179,7 @@ impl<S: SecondOrderSystem> FirstOrderForm<S> {
             damping: Mat::zeros(n, n),
             stiffness: Mat::zeros(n, n),
             zeros: vec![0.0; n],
-            lu: DenseLu::new(n),
+            lu: DenseLu::new(n).with_singular_pivot_ratio(0.0),
             residual_evals: 0,
             tangent_evals: 0,
         }
@@ -241,8 +241,10 @@ impl<S: SecondOrderSystem> OdeSystem for FirstOrderForm<S> {
             )?;
             let mut a = self.lu.matrix_mut();
             a.copy_from(&self.mass);
-            if !self.lu.factor() {
-                return Err(RhsError::new(format!("singular mass matrix at t = {t:e}")));
+            if let Err(e) = self.lu.factor_in_place() {
+                return Err(RhsError::new(format!(
+                    "singular mass matrix at t = {t:e} ({e})"
+                )));
             }
             self.factored = true;
         }
@@ -251,7 +253,7 @@ impl<S: SecondOrderSystem> OdeSystem for FirstOrderForm<S> {
         for v in dqd.iter_mut() {
             *v = -*v;
         }
-        self.lu.solve_in_place(dqd);
+        self.lu.solve_vec(dqd);
         dq.copy_from_slice(qd);
         Ok(())
     }

@@ -425,7 +425,7 @@ fn singular_mass_matrix() {
     let err = GeneralizedAlpha::default()
         .solve(&mut sys, 0.0, &[1.0, 0.0], &[0.0, 0.0], 1.0, &Output::Final)
         .unwrap_err();
-    assert!(matches!(err, OdeError::SingularMatrix { what: "mass", t } if t == 0.0));
+    assert!(matches!(err, OdeError::SingularMatrix { what: "mass", t, .. } if t == 0.0));
 }
 
 /// A tangent with NaN entries is reported with its flat index.

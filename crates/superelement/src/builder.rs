@@ -18,12 +18,12 @@
 //! * S̄ = [Ve W]ᵀ K [Ve W] (3.8), Ve = [V7, V10, V5, V11, V6, V12];
 //!   M̄ = [V W]ᵀ M [V W] (3.11).
 
-use crate::linalg::{dense_generalized_eigen, lowest_eigenpairs, to_hz};
 use crate::model::{cross, dot, norm, sub, FeModel, NodeSelection};
 use crate::reduction::{Expansion, ExtOps, MassBlock, Problem};
 use crate::Error;
 use faer::Mat;
 use flexmb_element::{frame_from_axis, LinearSuperelement, ModeKind, Provenance, Side};
+use flexmb_linalg::{generalized_eigen, lowest_eigenpairs, Definite};
 use nalgebra::{DMatrix, Matrix3};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -198,7 +198,7 @@ impl BuildResult {
         let n = keep.len();
         let kk = Mat::<f64>::from_fn(n, n, |i, j| self.k_full[(keep[i], keep[j])]);
         let mm = Mat::<f64>::from_fn(n, n, |i, j| m[(keep[i], keep[j])]);
-        let (lam, _) = dense_generalized_eigen(kk.as_ref(), mm.as_ref())?;
+        let lam = generalized_eigen(kk.as_ref(), mm.as_ref(), n, Definite::Either)?.values;
         Ok(to_hz(&lam))
     }
 
@@ -1340,7 +1340,20 @@ fn normal_modes(ctx: &Ctx<'_>, prob: &Problem, nev: usize) -> Result<(Vec<f64>, 
         ctx.ops.apply_m(u.as_ref(), mu.as_mut());
         out.copy_from(e.restrict(mu.as_ref()));
     };
-    lowest_eigenpairs(&prob.llt, apply_m, nev)
+    let n = prob.llt.n();
+    if nev > n {
+        return Err(Error::Spec(format!(
+            "{nev} normal modes requested but the interior has only {n} DOFs"
+        )));
+    }
+    Ok(lowest_eigenpairs(&prob.llt, apply_m, nev)?)
+}
+
+/// Frequencies (Hz) from eigenvalues ω².
+fn to_hz(lam: &[f64]) -> Vec<f64> {
+    lam.iter()
+        .map(|&l| l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+        .collect()
 }
 
 /// Eigenfrequencies (Hz) of the full FE model with interface p clamped and
@@ -1382,8 +1395,7 @@ pub fn fixed_interface_eigenvalues_dense(
     let mut mu = Mat::<f64>::zeros(ctx.n_ext, nf);
     ctx.ops.apply_m(u.as_ref(), mu.as_mut());
     let md = prob.e.restrict(mu.as_ref());
-    let (lam, _) = dense_generalized_eigen(kd.as_ref(), md.as_ref())?;
-    Ok(lam)
+    Ok(generalized_eigen(kd.as_ref(), md.as_ref(), nf, Definite::Either)?.values)
 }
 
 /// The same eigenvalues by the sparse shift-invert path (the `nev` lowest).

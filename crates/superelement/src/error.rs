@@ -111,6 +111,12 @@ pub enum Error {
     /// The element library rejected the result.
     #[error(transparent)]
     Element(#[from] flexmb_element::ElementError),
+    /// An eigensolver failed (`flexmb-linalg`).
+    #[error("eigensolver: {0}")]
+    Eigen(#[from] flexmb_linalg::EigenError),
+    /// A sparse Cholesky factorization could not be set up (`flexmb-linalg`).
+    #[error("solver: {0}")]
+    Cholesky(#[from] flexmb_linalg::CholeskyError),
 }
 
 impl Error {
@@ -153,7 +159,11 @@ impl Error {
     pub fn is_input(&self) -> bool {
         !matches!(
             self,
-            Error::Solver(_) | Error::Write { .. } | Error::Element(_)
+            Error::Solver(_)
+                | Error::Write { .. }
+                | Error::Element(_)
+                | Error::Eigen(_)
+                | Error::Cholesky(_)
         )
     }
 }

@@ -27,6 +27,12 @@
 //! * [`spec`]: a RON specification and [`build_from_spec`], the function behind
 //!   `flexmb build-superelement SPEC.ron`.
 //!
+//! The sparse Cholesky factorization, the shift-invert eigensolver and the
+//! dense generalized eigensolver are those of `flexmb-linalg`
+//! ([`flexmb_linalg::SparseCholesky`], [`flexmb_linalg::lowest_eigenpairs`],
+//! [`flexmb_linalg::generalized_eigen`]); their failures arrive as
+//! [`Error::Eigen`] and [`Error::Cholesky`].
+//!
 //! ```
 //! use flexmb_element::{Element, Material, VelocityTransform};
 //! use flexmb_superelement::{build, parts};
@@ -54,7 +60,6 @@ pub mod consistency;
 mod error;
 pub mod geometry;
 pub mod harwell_boeing;
-pub mod linalg;
 mod model;
 pub mod parts;
 pub mod readers;

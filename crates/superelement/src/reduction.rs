@@ -10,11 +10,11 @@
 //! The free unknowns minimize the energy: (Eᵀ K E) x = −Eᵀ K g. Rigid interfaces
 //! and links are thereby exact constraint transformations, not penalties.
 
-use crate::linalg::{FactorError, SparseCholesky};
 use crate::model::{build_upper, sym_mul_add, FeModel};
 use crate::Error;
 use faer::sparse::SparseColMat;
 use faer::{Mat, MatMut, MatRef};
+use flexmb_linalg::{CholeskyError, SparseCholesky};
 
 /// A dense mass block on a few extended indices (point masses).
 #[derive(Clone, Debug)]
@@ -215,14 +215,14 @@ impl Problem {
         }
         let llt = match SparseCholesky::factor(k_ff.as_ref()) {
             Ok(l) => l,
-            Err(FactorError::NonPositivePivot(j)) => {
+            Err(CholeskyError::NonPositivePivot { index: j }) => {
                 return Err(Error::NotPositiveSemiDefinite(format!(
                     "the Cholesky factorization of the interior stiffness broke down at {} (a zero or negative pivot): \
                      K is indefinite there, or that region is a mechanism / not attached to an interface",
                     describe(j)
                 )))
             }
-            Err(FactorError::Other(s)) => return Err(Error::Solver(format!("sparse Cholesky failed: {s}"))),
+            Err(e) => return Err(e.into()),
         };
         let (ratio, j) = llt.min_pivot_ratio(k_ff.as_ref());
         if ratio < 1e-13 {

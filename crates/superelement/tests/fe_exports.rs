@@ -6,7 +6,6 @@ use faer::Mat;
 use flexmb_superelement::abaqus::read_abaqus;
 use flexmb_superelement::ansys::{parse_ansys, read_ansys, AnsysFiles};
 use flexmb_superelement::harwell_boeing::write_harwell_boeing;
-use flexmb_superelement::linalg::dense_generalized_eigen;
 use flexmb_superelement::{build, BuildSettings, FeModel, NodeSelection, Spec};
 use std::path::{Path, PathBuf};
 
@@ -70,8 +69,12 @@ fn dense(a: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Mat<f64> {
 
 /// Free-free frequencies (Hz), signed: a negative eigenvalue gives −√|λ|/2π.
 fn frequencies(model: &FeModel) -> Vec<f64> {
-    let (l, _) =
-        dense_generalized_eigen(dense(model.k()).as_ref(), dense(model.m()).as_ref()).unwrap();
+    let n = model.n_eq();
+    let (k, m) = (dense(model.k()), dense(model.m()));
+    let l =
+        flexmb_linalg::generalized_eigen(k.as_ref(), m.as_ref(), n, flexmb_linalg::Definite::Mass)
+            .unwrap()
+            .values;
     l.iter()
         .map(|&x| x.signum() * x.abs().sqrt() / (2.0 * std::f64::consts::PI))
         .collect()

@@ -1,15 +1,23 @@
-//! Linear algebra on top of faer: one supernodal sparse Cholesky factorization
-//! (AMD ordering) used for the static solves and, as a shift-invert operator,
-//! for the lowest eigenpairs of K φ = λ M φ through faer's Krylov–Schur
-//! `partial_self_adjoint_eigen`; and the dense symmetric-definite generalized
-//! eigensolver (Cholesky of M, transformation, `self_adjoint_eigen`) used for
-//! small problems and as a check.
+//! A supernodal sparse Cholesky factorization `P A Pᵀ = L Lᵀ` (AMD ordering)
+//! and, with it as a shift-invert operator, the lowest eigenpairs of a large
+//! sparse pencil `K φ = λ M φ`.
+//!
+//! `flexmb-superelement` uses these for the Craig–Bampton reduction of a
+//! solid finite-element model: [`SparseCholesky`] factorizes the interior
+//! stiffness once for all static solves (constraint modes) and
+//! [`lowest_eigenpairs`] finds the fixed-interface normal modes through faer's
+//! Krylov–Schur `partial_self_adjoint_eigen` on the operator
+//! `y ↦ L⁻¹ P M Pᵀ L⁻ᵀ y`, whose largest eigenvalues are 1/λ of the smallest
+//! λ; two steps of shift-invert subspace iteration with a Rayleigh–Ritz
+//! projection ([`crate::eigen::generalized_eigen`]) then polish the pairs.
+//!
+//! The factorization is on faer's sparse supernodal Cholesky; errors are typed
+//! ([`CholeskyError`], [`EigenError`]).
 
-use crate::Error;
+use crate::eigen::{generalized_eigen, Definite, EigenError};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltParams;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
-use faer::linalg::triangular_solve;
 use faer::matrix_free::eigen::{
     partial_self_adjoint_eigen, partial_self_adjoint_eigen_scratch, PartialEigenParams,
 };
@@ -19,7 +27,7 @@ use faer::sparse::linalg::cholesky::{
     SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::SparseColMatRef;
+use faer::sparse::{FaerError, SparseColMatRef};
 use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 
 /// A supernodal Cholesky factorization P A Pᵀ = L Lᵀ of a sparse symmetric
@@ -30,30 +38,36 @@ pub struct SparseCholesky {
     n: usize,
 }
 
-/// Why a factorization failed.
-#[derive(Debug)]
-pub enum FactorError {
-    /// A pivot was not positive; the index is in the original (unpermuted) numbering.
-    NonPositivePivot(usize),
-    /// Anything else (out of memory, index overflow).
-    Other(String),
+/// Why a sparse Cholesky factorization failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum CholeskyError {
+    /// A pivot was not positive: the matrix is not positive definite.
+    #[error(
+        "the sparse Cholesky factorization broke down at row {index} (a zero or negative pivot)"
+    )]
+    NonPositivePivot {
+        /// The row, in the original (unpermuted) numbering.
+        index: usize,
+    },
+    /// faer could not set the factorization up (out of memory, index overflow).
+    #[error("sparse Cholesky: {0}")]
+    Faer(#[from] FaerError),
 }
 
 impl SparseCholesky {
     /// Factorizes `a` (upper triangle) with an AMD ordering.
-    pub fn factor(a: SparseColMatRef<'_, usize, f64>) -> Result<Self, FactorError> {
+    pub fn factor(a: SparseColMatRef<'_, usize, f64>) -> Result<Self, CholeskyError> {
         let n = a.nrows();
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
         let symbolic =
-            factorize_symbolic_cholesky(a.symbolic(), Side::Upper, SymmetricOrdering::Amd, params)
-                .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+            factorize_symbolic_cholesky(a.symbolic(), Side::Upper, SymmetricOrdering::Amd, params)?;
         let mut values = vec![0.0f64; symbolic.len_val()];
         let par = Par::Seq;
         let req = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
-        let mut buf = MemBuffer::try_new(req).map_err(|e| FactorError::Other(format!("{e:?}")))?;
+        let mut buf = MemBuffer::try_new(req).map_err(FaerError::from)?;
         let res = symbolic.factorize_numeric_llt::<f64>(
             &mut values,
             a,
@@ -70,7 +84,7 @@ impl SparseCholesky {
                     Some(p) => p.arrays().0[index.min(n.saturating_sub(1))],
                     None => index,
                 };
-                return Err(FactorError::NonPositivePivot(orig));
+                return Err(CholeskyError::NonPositivePivot { index: orig });
             }
         }
         Ok(Self {
@@ -240,15 +254,13 @@ pub fn lowest_eigenpairs(
     llt: &SparseCholesky,
     apply_m: impl Fn(MatRef<'_, f64>, MatMut<'_, f64>) + Sync,
     nev: usize,
-) -> Result<(Vec<f64>, Mat<f64>), Error> {
+) -> Result<(Vec<f64>, Mat<f64>), EigenError> {
     let n = llt.n;
     if nev == 0 {
         return Ok((Vec::new(), Mat::zeros(n, 0)));
     }
     if nev > n {
-        return Err(Error::Spec(format!(
-            "{nev} normal modes requested but the interior has only {n} DOFs"
-        )));
+        return Err(EigenError::TooMany { requested: nev, n });
     }
     let op = ShiftInvert { llt, apply_m };
     let params = PartialEigenParams::default();
@@ -273,10 +285,10 @@ pub fn lowest_eigenpairs(
         params,
     );
     if info.n_converged_eigen < nev {
-        return Err(Error::Solver(format!(
-            "the Krylov–Schur eigensolver converged {} of {nev} eigenpairs",
-            info.n_converged_eigen
-        )));
+        return Err(EigenError::PartialConvergence {
+            converged: info.n_converged_eigen,
+            requested: nev,
+        });
     }
     // back-transform: φ = Pᵀ L⁻ᵀ y, λ = 1/μ; M-normalize (φᵀMφ = μ for unit y).
     let l = llt.supernodal();
@@ -295,9 +307,7 @@ pub fn lowest_eigenpairs(
     let mut lam: Vec<f64> = Vec::with_capacity(nev);
     for (c, &(l, i)) in pairs.iter().enumerate() {
         if !(l.is_finite() && l > 0.0) {
-            return Err(Error::Solver(format!(
-                "eigenvalue {l} of a positive-definite pencil"
-            )));
+            return Err(EigenError::InvalidEigenvalue { value: l });
         }
         let s = (1.0 / vals[i]).sqrt() / vecs.col(i).norm_l2();
         for r in 0..n {
@@ -310,97 +320,138 @@ pub fn lowest_eigenpairs(
     let mut phi = out;
     for _ in 0..2 {
         let mut mphi = Mat::<f64>::zeros(n, nev);
-        apply(&op.apply_m, phi.as_ref(), mphi.as_mut());
+        (op.apply_m)(phi.as_ref(), mphi.as_mut());
         let mut y = mphi.clone();
         llt.solve_in_place(y.as_mut());
         let kr = y.transpose() * &mphi;
         let mut my = Mat::<f64>::zeros(n, nev);
-        apply(&op.apply_m, y.as_ref(), my.as_mut());
+        (op.apply_m)(y.as_ref(), my.as_mut());
         let mr = y.transpose() * &my;
         let kr = Mat::<f64>::from_fn(nev, nev, |i, j| 0.5 * (kr[(i, j)] + kr[(j, i)]));
         let mr = Mat::<f64>::from_fn(nev, nev, |i, j| 0.5 * (mr[(i, j)] + mr[(j, i)]));
-        let (l2, q) = dense_generalized_eigen(kr.as_ref(), mr.as_ref())?;
-        phi = &y * &q;
-        lam = l2;
+        let e = generalized_eigen(kr.as_ref(), mr.as_ref(), nev, Definite::Either)?;
+        phi = &y * &e.vectors;
+        lam = e.values;
     }
     Ok((lam, phi))
 }
 
-fn apply<F: Fn(MatRef<'_, f64>, MatMut<'_, f64>)>(f: &F, x: MatRef<'_, f64>, y: MatMut<'_, f64>) {
-    f(x, y)
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::{SparseColMat, Triplet};
 
-/// All eigenpairs of the dense symmetric-definite pencil (K, M), λ ascending,
-/// M-orthonormal φ.
-///
-/// When K is positive definite the pencil is transformed with the Cholesky
-/// factor of K: C = L_K⁻¹ M L_K⁻ᵀ has eigenvalues 1/λ, so the lowest modes
-/// (the ones of interest) are the dominant ones and keep their relative
-/// accuracy (with the factor of M, faer's `self_adjoint_eigen` lost ~6 digits
-/// of the lowest eigenvalue of a small solid model: its error is relative to
-/// ‖C‖ = λ_max). Otherwise (K singular) the factor of M is used. Eigenvalues
-/// are returned as Rayleigh quotients.
-pub fn dense_generalized_eigen(
-    k: MatRef<'_, f64>,
-    m: MatRef<'_, f64>,
-) -> Result<(Vec<f64>, Mat<f64>), Error> {
-    let n = k.nrows();
-    if k.ncols() != n || m.nrows() != n || m.ncols() != n {
-        return Err(Error::SizeMismatch(format!(
-            "dense eigenproblem: K is {}×{}, M is {}×{}",
-            k.nrows(),
-            k.ncols(),
-            m.nrows(),
-            m.ncols()
-        )));
-    }
-    let (a, b, inverted) = match k.llt(Side::Lower) {
-        Ok(_) => (k, m, true),
-        Err(_) => (m, k, false),
-    };
-    let llt = a.llt(Side::Lower).map_err(|e| {
-        Error::Solver(format!(
-            "neither K nor M is positive definite ({e:?}); the dense eigensolver needs one of them"
-        ))
-    })?;
-    let l = llt.L();
-    let mut c = b.to_owned();
-    triangular_solve::solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq);
-    let mut ct = c.transpose().to_owned();
-    triangular_solve::solve_lower_triangular_in_place(l, ct.as_mut(), Par::Seq);
-    let cs = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (ct[(i, j)] + ct[(j, i)]));
-    let evd = cs
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::Solver(format!("dense eigensolver failed ({e:?})")))?;
-    let s = evd.S();
-    let mut y = evd.U().to_owned();
-    triangular_solve::solve_upper_triangular_in_place(l.transpose(), y.as_mut(), Par::Seq);
-    let mut idx: Vec<usize> = (0..n).collect();
-    if inverted {
-        // μ = 1/λ descending ↔ λ ascending
-        idx.sort_by(|&a, &b| s[b].total_cmp(&s[a]));
-    } else {
-        idx.sort_by(|&a, &b| s[a].total_cmp(&s[b]));
-    }
-    let mut phi = Mat::<f64>::from_fn(n, n, |r, c| y[(r, idx[c])]);
-    let kp = k * &phi;
-    let mp = m * &phi;
-    let mut lam = Vec::with_capacity(n);
-    for c in 0..n {
-        let num: f64 = (0..n).map(|r| phi[(r, c)] * kp[(r, c)]).sum();
-        let den: f64 = (0..n).map(|r| phi[(r, c)] * mp[(r, c)]).sum();
-        lam.push(num / den);
-        let sc = 1.0 / den.abs().sqrt();
-        for r in 0..n {
-            phi[(r, c)] *= sc;
+    /// The upper triangle of the 1-D Laplacian tridiag(−1, 2, −1) of order n
+    /// (fixed ends), scaled by `k`, and its dense form.
+    fn laplacian(n: usize, k: f64) -> (SparseColMat<usize, f64>, Mat<f64>) {
+        let mut t = vec![];
+        for i in 0..n {
+            t.push(Triplet::new(i, i, 2.0 * k));
+            if i + 1 < n {
+                t.push(Triplet::new(i, i + 1, -k));
+            }
         }
+        let a = SparseColMat::try_new_from_triplets(n, n, &t).unwrap();
+        let d = Mat::from_fn(n, n, |i, j| {
+            if i == j {
+                2.0 * k
+            } else if i.abs_diff(j) == 1 {
+                -k
+            } else {
+                0.0
+            }
+        });
+        (a, d)
     }
-    Ok((lam, phi))
-}
 
-/// Frequencies (Hz) from eigenvalues ω².
-pub fn to_hz(lam: &[f64]) -> Vec<f64> {
-    lam.iter()
-        .map(|&l| l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
-        .collect()
+    /// A x = b with the known solution of the Laplacian: b = e_n gives
+    /// xᵢ = (i + 1)/(n + 1) (a linear ramp).
+    #[test]
+    fn solves_a_known_system() {
+        let n = 30;
+        let (a, d) = laplacian(n, 1.0);
+        let llt = SparseCholesky::factor(a.as_ref()).unwrap();
+        assert_eq!(llt.n(), n);
+        assert!(llt.factor_nnz() >= 2 * n - 1);
+        let mut x = Mat::<f64>::zeros(n, 2);
+        x[(n - 1, 0)] = 1.0;
+        x[(n - 1, 1)] = 2.0;
+        llt.solve_in_place(x.as_mut());
+        for i in 0..n {
+            let expect = (i + 1) as f64 / (n + 1) as f64;
+            assert!((x[(i, 0)] - expect).abs() < 1e-13, "x[{i}] = {}", x[(i, 0)]);
+            assert!((x[(i, 1)] - 2.0 * expect).abs() < 1e-13);
+        }
+        let r =
+            &d * x.col(0) - Mat::from_fn(n, 1, |i, _| if i == n - 1 { 1.0 } else { 0.0 }).col(0);
+        assert!(r.norm_max() < 1e-13);
+        // every pivot of a well-conditioned matrix is far from zero
+        let (ratio, _) = llt.min_pivot_ratio(a.as_ref());
+        assert!(ratio > 0.1 && ratio <= 1.0, "{ratio}");
+    }
+
+    /// An indefinite matrix fails with a typed error naming a row; no panic.
+    /// (faer 0.24 reports the failing pivot of this diagonal matrix, row 4, as
+    /// 5: the index can lie just past the bad pivot within its supernode.)
+    #[test]
+    fn indefinite_matrix_is_refused() {
+        let n = 6;
+        let mut t = vec![];
+        for i in 0..n {
+            t.push(Triplet::new(i, i, if i == 4 { -1.0 } else { 2.0 }));
+        }
+        let a = SparseColMat::try_new_from_triplets(n, n, &t).unwrap();
+        let err = SparseCholesky::factor(a.as_ref()).err().unwrap();
+        let CholeskyError::NonPositivePivot { index } = err else {
+            panic!("{err}");
+        };
+        assert!((4..n).contains(&index), "{err}");
+        assert!(err.to_string().contains("broke down at row"), "{err}");
+    }
+
+    /// The lowest eigenpairs of a fixed–fixed string, K = tridiag(−1, 2, −1) ·
+    /// 1e4 and M = 0.5·I: λⱼ = (4·1e4/0.5) sin²(jπ/(2(n + 1))), with
+    /// ΦᵀMΦ = I and small residuals K φ − λ M φ.
+    #[test]
+    fn lowest_eigenpairs_of_a_string() {
+        let n = 200;
+        let (k, kd) = laplacian(n, 1e4);
+        let llt = SparseCholesky::factor(k.as_ref()).unwrap();
+        let mass = 0.5;
+        let apply_m = |x: MatRef<'_, f64>, mut out: MatMut<'_, f64>| {
+            out.copy_from(x);
+            for j in 0..out.ncols() {
+                for i in 0..out.nrows() {
+                    out[(i, j)] *= mass;
+                }
+            }
+        };
+        let nev = 5;
+        let (lam, phi) = lowest_eigenpairs(&llt, apply_m, nev).unwrap();
+        for (j, l) in lam.iter().enumerate() {
+            let s = ((j + 1) as f64 * std::f64::consts::PI / (2.0 * (n + 1) as f64)).sin();
+            let expect = 4.0 * 1e4 / mass * s * s;
+            assert!(
+                (l / expect - 1.0).abs() < 1e-10,
+                "λ{j} = {l}, expected {expect}"
+            );
+        }
+        let vmv = phi.transpose() * &phi * mass;
+        assert!((vmv - Mat::<f64>::identity(nev, nev)).norm_max() < 1e-10);
+        let kv = &kd * &phi;
+        for j in 0..nev {
+            let r = (0..n)
+                .map(|i| (kv[(i, j)] - lam[j] * mass * phi[(i, j)]).abs())
+                .fold(0.0, f64::max);
+            assert!(r < 1e-8 * lam[j], "residual {r} of pair {j}");
+        }
+        assert_eq!(
+            lowest_eigenpairs(&llt, apply_m, n + 1).unwrap_err(),
+            EigenError::TooMany {
+                requested: n + 1,
+                n
+            }
+        );
+        assert_eq!(lowest_eigenpairs(&llt, apply_m, 0).unwrap().0.len(), 0);
+    }
 }

@@ -7,12 +7,18 @@
 //! diagonal. The Cholesky factor has the same profile (no fill outside it),
 //! so pattern and memory are set up once and every factorization is a pass
 //! of contiguous dot products over the rows.
+//!
+//! `flexmb-dynamics` factorizes the mass matrix of its nodal equations of
+//! motion this way at every evaluation: [`reverse_cuthill_mckee`] orders the
+//! coordinates once, [`Skyline::new`] sets up the profile, and
+//! [`Skyline::factor`], [`Skyline::solve_lower`], [`Skyline::solve_upper`] and
+//! [`Skyline::solve_lower_rows`] work in that memory without allocating.
 
 /// Orders the vertices of a graph (adjacency lists) by reverse Cuthill–McKee:
 /// breadth first from a low-degree vertex of each component, neighbours by
 /// increasing degree, the whole order reversed. Returns `perm` with
 /// `perm[new] = old`.
-pub(crate) fn reverse_cuthill_mckee(adj: &[Vec<usize>]) -> Vec<usize> {
+pub fn reverse_cuthill_mckee(adj: &[Vec<usize>]) -> Vec<usize> {
     let n = adj.len();
     let mut seen = vec![false; n];
     let mut order = Vec::with_capacity(n);
@@ -90,7 +96,7 @@ fn pseudo_peripheral(adj: &[Vec<usize>], start: usize) -> usize {
 /// `first[i] ..= i` contiguously. After [`factor`](Self::factor) the same
 /// storage holds the lower Cholesky factor L (A = L Lᵀ).
 #[derive(Clone, Debug)]
-pub(crate) struct Skyline {
+pub struct Skyline {
     first: Vec<usize>,
     start: Vec<usize>,
     values: Vec<f64>,
@@ -99,8 +105,13 @@ pub(crate) struct Skyline {
 }
 
 /// Failure of [`Skyline::factor`]: the row whose pivot is not positive.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct NotPositiveDefinite {
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "the skyline matrix is not positive definite: the Cholesky pivot of row {row} \
+     is not above 1e-13 of its diagonal entry (or not finite)"
+)]
+pub struct NotPositiveDefinite {
+    /// The row (in the skyline's order) whose pivot failed.
     pub row: usize,
 }
 
@@ -134,7 +145,6 @@ impl Skyline {
     }
 
     /// Stored entries.
-    #[cfg(test)]
     pub fn nnz(&self) -> usize {
         self.values.len()
     }
@@ -145,7 +155,6 @@ impl Skyline {
     }
 
     /// A(i, j) += v for i ≥ j inside the profile.
-    #[cfg(test)]
     pub fn add_lower(&mut self, i: usize, j: usize, v: f64) {
         let p = self.position(i, j);
         self.values[p] += v;
@@ -355,6 +364,35 @@ mod tests {
         }
     }
 
+    /// The tridiagonal matrix tridiag(−1, 2, −1) of order 4 with x = (1, 2, 3, 4):
+    /// b = A x = (0, 0, 0, 5); its factor has L(i, i) = √((i + 2)/(i + 1)).
+    #[test]
+    fn known_solution_of_a_tridiagonal_system() {
+        let n = 4;
+        let mut s = Skyline::new(n, (1..n).map(|i| (i, i - 1)));
+        assert_eq!((s.n(), s.nnz()), (4, 7));
+        for i in 0..n {
+            s.add_lower(i, i, 2.0);
+            if i > 0 {
+                s.add_at(s.position(i, i - 1), -1.0);
+            }
+        }
+        assert_eq!(s.get(0, 2), 0.0);
+        s.factor().unwrap();
+        for i in 0..n {
+            let expect = ((i as f64 + 2.0) / (i as f64 + 1.0)).sqrt();
+            assert!((s.get(i, i) - expect).abs() < 1e-15);
+        }
+        let mut x = vec![0.0, 0.0, 0.0, 5.0];
+        s.solve_lower(&mut x);
+        s.solve_upper(&mut x);
+        for (xi, ei) in x.iter().zip([1.0, 2.0, 3.0, 4.0]) {
+            assert!((xi - ei).abs() < 1e-14, "{x:?}");
+        }
+        s.clear();
+        assert_eq!(s.get(3, 3), 0.0);
+    }
+
     #[test]
     fn a_matrix_that_is_not_positive_definite_names_its_row() {
         let mut s = Skyline::new(3, [(1, 0), (2, 1)]);
@@ -362,7 +400,12 @@ mod tests {
         s.add_lower(1, 0, 2.0);
         s.add_lower(1, 1, 1.0); // 1 − 2² < 0
         s.add_lower(2, 2, 1.0);
-        assert_eq!(s.factor(), Err(NotPositiveDefinite { row: 1 }));
+        let err = s.factor().unwrap_err();
+        assert_eq!(err, NotPositiveDefinite { row: 1 });
+        assert!(err.to_string().contains("row 1"), "{err}");
+        // a zero matrix: the first pivot fails
+        let mut zero = Skyline::new(2, [(1, 0)]);
+        assert_eq!(zero.factor(), Err(NotPositiveDefinite { row: 0 }));
         let mut z = Skyline::new(2, []);
         z.add_lower(0, 0, 1.0);
         z.add_lower(1, 1, f64::NAN);
