@@ -27,7 +27,10 @@ fn dof_names(text: &str) -> Vec<String> {
 fn reordered_nodes_build_the_same_degrees_of_freedom() {
     let c = "        (id: \"C\", at: [0.5, 0.3, 0.0]),\n";
     let e = "        (id: \"E\", at: [0.8, 0.0, 0.0]),\n";
-    assert!(SEED.contains(c) && SEED.contains(e), "the seed scene changed");
+    assert!(
+        SEED.contains(c) && SEED.contains(e),
+        "the seed scene changed"
+    );
     let reordered = SEED.replace(c, "").replace(e, &format!("{e}{c}"));
     assert_ne!(reordered, SEED);
     let original = dof_names(SEED);
