@@ -544,6 +544,26 @@ impl Element {
     /// gives it a constant mass matrix. Errors: sizes that disagree, a
     /// non-finite stiffness, and `NX` or `NE` above [`MAX_ELEMENT_COORDS`]
     /// ([`ElementError::TooLarge`]).
+    ///
+    /// To place it in a mechanism, see `flexmb_model::Scene::build_with_elements`.
+    ///
+    /// ```
+    /// use flexmb_dual::Real;
+    /// use flexmb_element::{DeformationKernel, Element, Slot};
+    /// use nalgebra::DMatrix;
+    /// /// A planar torsion spring between two angles: ε = φq − φp (5.5).
+    /// struct Spring;
+    /// impl DeformationKernel<2, 1> for Spring {
+    ///     fn eval<T: Real>(&self, x: &[T; 2]) -> [T; 1] {
+    ///         [x[1] - x[0]]
+    ///     }
+    /// }
+    /// let e = Element::custom("spring", Spring, &[Slot::Angle, Slot::Angle], &["rotation"],
+    ///                         DMatrix::from_element(1, 1, 5.0)).unwrap();
+    /// let (mut eps, mut jac) = ([0.0], [0.0; 2]);
+    /// e.deformations_and_jacobian(&[0.1, 0.4], None, &mut eps, &mut jac);
+    /// assert!((eps[0] - 0.3).abs() < 1e-15 && jac == [-1.0, 1.0]);
+    /// ```
     pub fn custom<K, const NX: usize, const NE: usize>(
         type_name: &'static str,
         kernel: K,
@@ -1216,7 +1236,7 @@ impl Element {
 
     /// The velocity-quadratic inertia force h(x, ẋ) = F(x, ẋ, 0).
     pub fn inertia_h(&self, x: &[f64], xd: &[f64], out: &mut [f64]) {
-        let zero = [0.0; 14 + MAX_MODES];
+        let zero = [0.0; MAX_ELEMENT_COORDS];
         self.inertia_force(x, xd, &zero[..self.n_x()], out)
     }
 

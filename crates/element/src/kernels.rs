@@ -24,7 +24,7 @@ use flexmb_rotation::generic::{rotation, triad_axis};
 ///
 /// Rules for `eval`:
 /// * Only use the operations of [`Real`] (`+ − × ÷`, with `f64` on the
-///   right, `sqrt`, `sin`, `cos`, `atan2`, …) on values derived from `x`;
+///   right, `sq`, `sqrt`, `sin`, `cos`, `atan2`) on values derived from `x`;
 ///   lift constants with [`Real::cst`]. Branching on [`Real::value`] is
 ///   allowed where the function is smooth across the branch.
 /// * x is in slot order (the element's [`Slot`](crate::Slot)s, e.g.

@@ -18,6 +18,13 @@
 //! spatial beam (6.2), spatial truss, spatial hinge, point mass, rigid body,
 //! two-node superelement (chapters 2–3) and the Euler-parameter normalization.
 //!
+//! Your own element: implement [`DeformationKernel`] (ε = D(x) once over
+//! [`flexmb_dual::Real`]) and build it with [`Element::custom`]; its exact
+//! derivatives follow as for the built-ins, and
+//! `flexmb_model::Scene::build_with_elements` places it in a mechanism (see
+//! `docs/elements.md`, "Writing your own element", and
+//! `examples/custom_element.rs`). Built-in elements stay statically dispatched.
+//!
 //! ```
 //! use flexmb_element::{BeamOptions, Element, Material, SectionShape};
 //! let steel = Material::from_poisson(2.1e11, 0.3, 7800.0);
