@@ -493,3 +493,52 @@ fn build_with_elements_checks_its_elements() {
     let e = place("m", &["A", "B"]).unwrap_err().to_string();
     assert!(e.contains("'m'"), "{e}");
 }
+
+/// A chain of planar points as large as the buffers allow: ε = its length − l0.
+struct Chain {
+    l0: f64,
+}
+impl DeformationKernel<MAX_ELEMENT_COORDS, 1> for Chain {
+    fn eval<T: Real>(&self, x: &[T; MAX_ELEMENT_COORDS]) -> [T; 1] {
+        let mut l = T::zero();
+        for i in 0..MAX_ELEMENT_COORDS / 2 - 1 {
+            let (dx, dy) = (x[2 * i + 2] - x[2 * i], x[2 * i + 3] - x[2 * i + 1]);
+            l += (dx * dx + dy * dy).sqrt();
+        }
+        [l - self.l0]
+    }
+}
+
+#[test]
+fn the_largest_custom_element_evaluates_on_a_default_thread_stack() {
+    let n = MAX_ELEMENT_COORDS;
+    let k = n / 2 - 1;
+    let e = Element::custom(
+        "chain",
+        Chain { l0: k as f64 },
+        &vec![Slot::Position2; n / 2],
+        &["elongation"],
+        DMatrix::from_element(1, 1, 1.0),
+    )
+    .unwrap();
+    // a worker thread with Rust's default 2 MiB stack (as rayon's)
+    std::thread::Builder::new()
+        .stack_size(2 << 20)
+        .spawn(move || {
+            let x: Vec<f64> = (0..n)
+                .map(|i| if i % 2 == 0 { (i / 2) as f64 } else { 0.0 })
+                .collect();
+            let a = vec![0.1; n];
+            assert!(eps(&e, &x)[0].abs() < 1e-12);
+            let j = jac(&e, &x);
+            assert!((j[0] + 1.0).abs() < 1e-12 && (j[n - 2] - 1.0).abs() < 1e-12);
+            assert!(second(&e, &x, &a, &a)[0].abs() < 1e-12);
+            assert!(third(&e, &x, &a, &a, &a)[0].is_finite());
+            let h = hess(&e, &x, &[1.0]);
+            // a straight chain: only transverse (y) second derivatives
+            assert!(h[n + 1] > 0.5 && h[0].abs() < 1e-12);
+        })
+        .unwrap()
+        .join()
+        .unwrap();
+}
