@@ -355,8 +355,8 @@ impl Dynamics {
         if let (Some(g0), true) = (mech.gravity, gravity) {
             // the load scale of a load sweep does not scale gravity
             let g = g0.map(|v| v * self.load_factor);
-            let mut xl = [0.0; 64];
-            let mut fl = [0.0; 64];
+            let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+            let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
             for e in &mech.elements {
                 if !e.element.has_inertia() {
                     continue;
@@ -425,10 +425,10 @@ impl Dynamics {
             self.mq.fill(0.0);
             asm.pending = 0;
         }
-        let mut xl = [0.0; 64];
-        let mut vl = [0.0; 64];
-        let mut al = [0.0; 64];
-        let mut fl = [0.0; 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut al = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in mech.elements.iter().enumerate() {
             if !e.element.has_inertia() {
                 continue;
@@ -579,8 +579,8 @@ impl Dynamics {
     /// Mx v (element by element), added to `out` (length n_x).
     pub(crate) fn mass_times_add(&self, v: &[f64], out: &mut [f64]) {
         let x = self.kin.x();
-        let mut xl = [0.0; 64];
-        let mut ml = [0.0; 64 * 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut ml = [0.0; flexmb_element::MAX_ELEMENT_COORDS * flexmb_element::MAX_ELEMENT_COORDS];
         for e in &self.mech.elements {
             if !e.element.has_inertia() {
                 continue;
@@ -756,8 +756,8 @@ impl Dynamics {
             gravity_exact: true,
             ..Default::default()
         };
-        let mut xl = [0.0; 64];
-        let mut vl = [0.0; 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (index, e) in mech.elements.iter().enumerate() {
             let n = e.x_index.len();
             for (k, gi) in e.x_index.iter().enumerate() {

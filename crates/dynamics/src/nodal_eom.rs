@@ -539,10 +539,10 @@ impl NodalEom {
         }
         kin.add_deformation_forces(&self.neg_sigma, &mut self.fx);
         self.mass.clear();
-        let mut xl = [0.0; 64];
-        let mut vl = [0.0; 64];
-        let mut al = [0.0; 64];
-        let mut fl = [0.0; 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut al = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in mech.elements.iter().enumerate() {
             if !e.element.has_inertia() {
                 continue;

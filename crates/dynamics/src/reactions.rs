@@ -45,10 +45,10 @@ impl Dynamics {
         }
         let (x, xd) = (view.x, view.xd);
         let mut r: Vec<f64> = self.f.iter().map(|v| -v).collect();
-        let mut xl = [0.0; 64];
-        let mut vl = [0.0; 64];
-        let mut al = [0.0; 64];
-        let mut fl = [0.0; 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut al = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for e in mech.elements.iter().filter(|e| e.element.has_inertia()) {
             let n = e.x_index.len();
             e.gather(x, &mut xl[..n]);

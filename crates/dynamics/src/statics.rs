@@ -177,7 +177,7 @@ impl Dynamics {
         for el in &mech.elements {
             let ne = el.element.n_eps();
             let o = el.eps_offset;
-            let mut active = [0usize; 64];
+            let mut active = [0usize; flexmb_element::MAX_ELEMENT_COORDS];
             let mut na = 0;
             for a in 0..ne {
                 if !matches!(
@@ -273,8 +273,9 @@ impl Dynamics {
         };
         if let Some(g0) = mech.gravity {
             let g = g0.map(|v| v * self.load_factor);
-            let mut xl = [0.0; 64];
-            let mut d = vec![0.0; 64 * 64];
+            let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+            let mut d =
+                vec![0.0; flexmb_element::MAX_ELEMENT_COORDS * flexmb_element::MAX_ELEMENT_COORDS];
             for e in &mech.elements {
                 if !e.element.has_inertia() {
                     continue;

@@ -7,9 +7,10 @@ use crate::beam_matrices::{
     equivalent_stiffness, planar_a_diag, planar_beam_m_bar, planar_beam_s_bar, spatial_a_diag,
     spatial_beam_m_bar, spatial_beam_s_bar,
 };
+use crate::custom::{CustomKind, Erased, MAX_ELEMENT_COORDS};
 use crate::inertia::{psd_factor, PlanarInertia, SpatialInertia, VelocityTransform, MAX_MODES};
 use crate::kernels::{
-    jacobian, second_directional, third_directional, weighted_hessian, DefKernel,
+    jacobian, second_directional, third_directional, weighted_hessian, DeformationKernel,
     NormalizationKernel, PlanarBeamKernel, PlanarHingeKernel, SpatialHingeKernel, TrussKernel,
     TwoNodeSpatial,
 };
@@ -109,6 +110,9 @@ enum Kind {
     },
     RigidBody(SpatialInertia),
     Normalization,
+    /// A user-defined element ([`Element::custom`]): the only kind behind
+    /// dynamic dispatch.
+    Custom(CustomKind),
 }
 
 impl PartialEq for PlanarBeamKernel {
@@ -521,6 +525,143 @@ impl Element {
         )
     }
 
+    /// A user-defined element from its deformation functions ε = D(x)
+    /// (thesis (2.15), (5.2)), written once over a generic scalar in a
+    /// [`DeformationKernel`]: D,x, D,xx\[a, b\], D,xxx\[a, b, c\] and Σ wᵢ Dᵢ,xx
+    /// follow exactly by dual numbers, as for the built-in elements.
+    ///
+    /// * `slots`: the nodal-coordinate slots, in the order of the kernel's x;
+    ///   their lengths must add up to `NX`.
+    /// * `deformation_names`: one name per deformation (`NE`), unique; they
+    ///   name the deformations in scenes and outputs (`ID.name`).
+    /// * `stiffness`: S in deformation space (`NE × NE`, finite), σ = Sε
+    ///   (+ Dε̇ + σ0, see [`with_damping`](Self::with_damping) and
+    ///   [`with_initial_stress`](Self::with_initial_stress)); the elastic
+    ///   energy is ½ εᵀSε (thesis (E.2)).
+    /// * `type_name`: a short name for messages and summaries.
+    ///
+    /// The element is massless unless [`with_mass_matrix`](Self::with_mass_matrix)
+    /// gives it a constant mass matrix. Errors: sizes that disagree, a
+    /// non-finite stiffness, and `NX` or `NE` above [`MAX_ELEMENT_COORDS`]
+    /// ([`ElementError::TooLarge`]).
+    ///
+    /// To place it in a mechanism, see `flexmb_model::Scene::build_with_elements`.
+    ///
+    /// ```
+    /// use flexmb_dual::Real;
+    /// use flexmb_element::{DeformationKernel, Element, Slot};
+    /// use nalgebra::DMatrix;
+    /// /// A planar torsion spring between two angles: ε = φq − φp (5.5).
+    /// struct Spring;
+    /// impl DeformationKernel<2, 1> for Spring {
+    ///     fn eval<T: Real>(&self, x: &[T; 2]) -> [T; 1] {
+    ///         [x[1] - x[0]]
+    ///     }
+    /// }
+    /// let e = Element::custom("spring", Spring, &[Slot::Angle, Slot::Angle], &["rotation"],
+    ///                         DMatrix::from_element(1, 1, 5.0)).unwrap();
+    /// let (mut eps, mut jac) = ([0.0], [0.0; 2]);
+    /// e.deformations_and_jacobian(&[0.1, 0.4], None, &mut eps, &mut jac);
+    /// assert!((eps[0] - 0.3).abs() < 1e-15 && jac == [-1.0, 1.0]);
+    /// ```
+    pub fn custom<K, const NX: usize, const NE: usize>(
+        type_name: &'static str,
+        kernel: K,
+        slots: &[Slot],
+        deformation_names: &[&str],
+        stiffness: DMatrix<f64>,
+    ) -> Result<Self, ElementError>
+    where
+        K: DeformationKernel<NX, NE> + Send + Sync + 'static,
+    {
+        for (what, n) in [("nodal coordinates", NX), ("deformations", NE)] {
+            if n > MAX_ELEMENT_COORDS {
+                return Err(ElementError::TooLarge {
+                    element: type_name.to_string(),
+                    what,
+                    n,
+                    max: MAX_ELEMENT_COORDS,
+                });
+            }
+        }
+        let bad = |what: &str, why: String| ElementError::InvalidProperty {
+            what: format!("custom element '{type_name}' {what}"),
+            value: f64::NAN,
+            why,
+        };
+        let n_slots: usize = slots.iter().map(|s| s.len()).sum();
+        if n_slots != NX {
+            return Err(bad(
+                "slots",
+                format!("{slots:?} hold {n_slots} coordinates, the kernel takes NX = {NX}"),
+            ));
+        }
+        if deformation_names.len() != NE {
+            return Err(bad(
+                "deformation names",
+                format!(
+                    "{} names given, the kernel has NE = {NE} deformations",
+                    deformation_names.len()
+                ),
+            ));
+        }
+        for (i, a) in deformation_names.iter().enumerate() {
+            if a.is_empty() || deformation_names[..i].contains(a) {
+                return Err(bad(
+                    "deformation names",
+                    format!("'{a}' is empty or given twice; give each deformation its own name"),
+                ));
+            }
+        }
+        let e = Self::new(
+            Kind::Custom(CustomKind {
+                kernel: std::sync::Arc::new(Erased::<K, NX, NE> {
+                    kernel,
+                    name: type_name,
+                    _sizes: std::marker::PhantomData,
+                }),
+                mass: None,
+            }),
+            slots.to_vec(),
+            names(deformation_names),
+            DMatrix::zeros(NE, NE),
+        );
+        e.with_stiffness(stiffness)
+    }
+
+    /// Gives a custom element ([`custom`](Self::custom)) a constant mass
+    /// matrix M (n_x × n_x, symmetric positive semi-definite) over its local
+    /// coordinates: kinetic energy T = ½ ẋᵀMẋ, inertia force M ẍ (h = 0),
+    /// gravity force M ẋ_g with ẋ_g = g on every position slot. This is the
+    /// inertia of trusses and point masses; for co-rotational inertia (beams,
+    /// rigid bodies) add built-in mass elements on the element's nodes.
+    pub fn with_mass_matrix(mut self, m: DMatrix<f64>) -> Result<Self, ElementError> {
+        let n = self.n_x();
+        let bad = |why: String| ElementError::InvalidProperty {
+            what: "mass matrix".into(),
+            value: m.nrows() as f64,
+            why,
+        };
+        let Kind::Custom(c) = &mut self.kind else {
+            return Err(bad(format!(
+                "only a custom element takes a mass matrix, not a {}",
+                self.type_name()
+            )));
+        };
+        if m.nrows() != n || m.ncols() != n || m.iter().any(|v| !v.is_finite()) {
+            return Err(bad(format!("must be a finite {n} × {n} matrix")));
+        }
+        let rm: Vec<f64> = (0..n * n).map(|k| m[(k / n, k % n)]).collect();
+        let asym = (0..n * n)
+            .map(|k| (rm[k] - rm[(k % n) * n + k / n]).abs())
+            .fold(0.0, f64::max);
+        if asym > 1e-12 * m.amax() || psd_factor(&rm, n).is_none() {
+            return Err(bad("must be symmetric positive semi-definite".into()));
+        }
+        c.mass = rm.iter().any(|v| *v != 0.0).then_some(rm);
+        Ok(self)
+    }
+
     /// Sets the damping matrix in deformation space (n_ε × n_ε).
     pub fn with_damping(mut self, d: DMatrix<f64>) -> Result<Self, ElementError> {
         let n = self.n_eps();
@@ -609,6 +750,7 @@ impl Element {
             Kind::PointMass { .. } => "point mass",
             Kind::RigidBody(_) => "rigid body",
             Kind::Normalization => "Euler-parameter normalization",
+            Kind::Custom(c) => c.kernel.type_name(),
         }
     }
 
@@ -620,6 +762,7 @@ impl Element {
             Kind::PlanarMass { .. } | Kind::PointMass { .. } | Kind::RigidBody(_) => true,
             Kind::TwoNode { inertia, .. } => inertia.is_some(),
             Kind::PlanarHinge | Kind::Hinge { .. } | Kind::Normalization => false,
+            Kind::Custom(c) => c.mass.is_some(),
         }
     }
 
@@ -724,9 +867,12 @@ impl Element {
         macro_rules! go {
             ($k:expr, $nx:literal, $ne:literal) => {{
                 let xa: [f64; $nx] = std::array::from_fn(|i| x[i]);
-                let e = DefKernel::<$nx, $ne>::eval($k, &xa);
+                let e = DeformationKernel::<$nx, $ne>::eval($k, &xa);
                 eps[..$ne].copy_from_slice(&e);
             }};
+        }
+        if let Kind::Custom(c) = &self.kind {
+            return c.kernel.deformations(x, eps);
         }
         self.dispatch_def(x, prev, |k| each_kernel!(k, go));
         self.copy_modes(x, eps);
@@ -753,7 +899,10 @@ impl Element {
                 f(KRef::Hinge3(&SpatialHingeKernel { r0: *r0, offset }))
             }
             Kind::Normalization => f(KRef::Norm(&NormalizationKernel)),
-            Kind::PlanarMass { .. } | Kind::PointMass { .. } | Kind::RigidBody(_) => {}
+            Kind::PlanarMass { .. }
+            | Kind::PointMass { .. }
+            | Kind::RigidBody(_)
+            | Kind::Custom(_) => {}
         }
     }
 
@@ -776,6 +925,9 @@ impl Element {
                     jac[r * nx..r * nx + $nx].copy_from_slice(&j[r]);
                 }
             }};
+        }
+        if let Kind::Custom(c) = &self.kind {
+            return c.kernel.jacobian(x, eps, jac);
         }
         self.dispatch_def(x, prev, |k| each_kernel!(k, go));
         let k = self.mode_count();
@@ -801,6 +953,9 @@ impl Element {
                 out[..$ne].copy_from_slice(&d);
             }};
         }
+        if let Kind::Custom(c) = &self.kind {
+            return c.kernel.second(x, a, b, out);
+        }
         self.dispatch_def(x, None, |k| each_kernel!(k, go));
         let k = self.mode_count();
         if k > 0 {
@@ -825,6 +980,9 @@ impl Element {
                 out[..$ne].copy_from_slice(&d);
             }};
         }
+        if let Kind::Custom(k) = &self.kind {
+            return k.kernel.third(x, a, b, c, out);
+        }
         self.dispatch_def(x, None, |k| each_kernel!(k, go));
         let k = self.mode_count();
         if k > 0 {
@@ -846,6 +1004,9 @@ impl Element {
                     out[r * nx..r * nx + $nx].copy_from_slice(&h[r]);
                 }
             }};
+        }
+        if let Kind::Custom(c) = &self.kind {
+            return c.kernel.weighted_hessian(x, w, out);
         }
         self.dispatch_def(x, None, |k| each_kernel!(k, go));
     }
@@ -982,6 +1143,7 @@ impl Element {
                     out[a * n + a] = *m;
                 }
             }
+            Kind::Custom(CustomKind { mass: Some(m), .. }) => out[..n * n].copy_from_slice(m),
             _ => {}
         }
     }
@@ -1034,6 +1196,11 @@ impl Element {
                 out[..n * n].copy_from_slice(&u);
                 Some(n)
             }
+            Kind::Custom(CustomKind { mass: Some(m), .. }) => {
+                let u = psd_factor(m, n)?;
+                out[..n * n].copy_from_slice(&u);
+                Some(n)
+            }
             _ => Some(0),
         }
     }
@@ -1058,13 +1225,18 @@ impl Element {
                     out[r] = (0..n).map(|c| m[r * n + c] * xdd[c]).sum();
                 }
             }
+            Kind::Custom(CustomKind { mass: Some(m), .. }) => {
+                for r in 0..n {
+                    out[r] = (0..n).map(|c| m[r * n + c] * xdd[c]).sum();
+                }
+            }
             _ => out[..n].fill(0.0),
         }
     }
 
     /// The velocity-quadratic inertia force h(x, ẋ) = F(x, ẋ, 0).
     pub fn inertia_h(&self, x: &[f64], xd: &[f64], out: &mut [f64]) {
-        let zero = [0.0; 14 + MAX_MODES];
+        let zero = [0.0; MAX_ELEMENT_COORDS];
         self.inertia_force(x, xd, &zero[..self.n_x()], out)
     }
 
@@ -1129,6 +1301,16 @@ impl Element {
                 }
                 e
             }
+            Kind::Custom(CustomKind { mass: Some(m), .. }) => {
+                let n = self.n_x();
+                let mut e = 0.0;
+                for r in 0..n {
+                    for c in 0..n {
+                        e += 0.5 * xd[r] * m[r * n + c] * xd[c];
+                    }
+                }
+                e
+            }
             _ => 0.0,
         }
     }
@@ -1163,6 +1345,20 @@ impl Element {
                 }
                 let zero = [0.0; 6];
                 self.inertia_force(x, &zero, &xg, out);
+            }
+            Kind::Custom(CustomKind { mass: Some(_), .. }) => {
+                let mut xg = [0.0; MAX_ELEMENT_COORDS];
+                let mut i = 0;
+                for s in &self.slots {
+                    match s {
+                        Slot::Position2 => xg[i..i + 2].copy_from_slice(&g[..2]),
+                        Slot::Position3 => xg[i..i + 3].copy_from_slice(g),
+                        _ => {}
+                    }
+                    i += s.len();
+                }
+                let zero = [0.0; MAX_ELEMENT_COORDS];
+                self.inertia_force(x, &zero[..n], &xg[..n], out);
             }
             _ => out[..n].fill(0.0),
         }

@@ -5,13 +5,55 @@
 use flexmb_dual::{Dual, Dual2, Real, Vec3};
 use flexmb_rotation::generic::{rotation, triad_axis};
 
-/// A deformation function with `NX` local nodal coordinates and `NE` deformations.
-pub(crate) trait DefKernel<const NX: usize, const NE: usize> {
+/// The deformation functions ε = D(x) of an element with `NX` local nodal
+/// coordinates and `NE` deformations, written once over a generic scalar.
+///
+/// This is the interface every element of the crate implements and the one a
+/// user implements to add an element ([`Element::custom`](crate::Element::custom);
+/// see `docs/elements.md`, "Writing your own element"). `eval` is called with
+/// `T = f64` for the deformations themselves (thesis (2.15), (5.2)), and with
+/// the dual numbers of [`flexmb_dual`] to obtain, exactly and without any
+/// hand-written derivative,
+/// * the first-order geometric transfer function D,x (thesis (5.8a), (6.5)):
+///   [`Dual<f64, NX>`](flexmb_dual::Dual) seeded with the identity,
+/// * the convective terms D,xx\[a, b\] (thesis (5.8b)) and the third
+///   directional derivative D,xxx\[a, b, c\] (thesis (E.5f)): nested
+///   one-direction duals,
+/// * the weighted Hessian Σᵢ wᵢ Dᵢ,xx of the geometric stiffness (thesis
+///   (E.5), σᵀD,xx): `Dual<Dual<f64, NX>, NX>`.
+///
+/// Rules for `eval`:
+/// * Only use the operations of [`Real`] (`+ − × ÷`, with `f64` on the
+///   right, `sq`, `sqrt`, `sin`, `cos`, `atan2`) on values derived from `x`;
+///   lift constants with [`Real::cst`]. Branching on [`Real::value`] is
+///   allowed where the function is smooth across the branch.
+/// * x is in slot order (the element's [`Slot`](crate::Slot)s, e.g.
+///   (x_p, y_p, x_q, y_q) for two [`Slot::Position2`](crate::Slot)s).
+/// * ε must be invariant under rigid motion of the element (thesis §2.2:
+///   a rigid translation and rotation of all its nodes leaves every εᵢ
+///   unchanged) and zero in the reference configuration for an unstressed
+///   element; the kinematics relies on the first, the statics on the second.
+///
+/// ```
+/// use flexmb_dual::Real;
+/// use flexmb_element::DeformationKernel;
+/// /// A planar rod: ε = l − l0 on x = (x_p, y_p, x_q, y_q).
+/// struct Rod { l0: f64 }
+/// impl DeformationKernel<4, 1> for Rod {
+///     fn eval<T: Real>(&self, x: &[T; 4]) -> [T; 1] {
+///         let (dx, dy) = (x[2] - x[0], x[3] - x[1]);
+///         [(dx * dx + dy * dy).sqrt() - self.l0]
+///     }
+/// }
+/// assert_eq!(Rod { l0: 1.0 }.eval(&[0.0, 0.0, 2.0, 0.0]), [1.0]);
+/// ```
+pub trait DeformationKernel<const NX: usize, const NE: usize> {
+    /// ε = D(x) over the scalar `T`.
     fn eval<T: Real>(&self, x: &[T; NX]) -> [T; NE];
 }
 
 /// ε and D,x (row-major `NE × NX`) by one forward pass with `NX` seeds.
-pub(crate) fn jacobian<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
+pub(crate) fn jacobian<K: DeformationKernel<NX, NE>, const NX: usize, const NE: usize>(
     k: &K,
     x: &[f64; NX],
 ) -> ([f64; NE], [[f64; NX]; NE]) {
@@ -21,7 +63,7 @@ pub(crate) fn jacobian<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
 }
 
 /// The directional second derivative D,xx\[a, b\] (and D,x a as by-product).
-pub(crate) fn second_directional<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
+pub(crate) fn second_directional<K: DeformationKernel<NX, NE>, const NX: usize, const NE: usize>(
     k: &K,
     x: &[f64; NX],
     a: &[f64; NX],
@@ -33,7 +75,7 @@ pub(crate) fn second_directional<K: DefKernel<NX, NE>, const NX: usize, const NE
 
 /// The directional third derivative D,xxx\[a, b, c\] (for the linearization of
 /// convective terms, (E.5f)).
-pub(crate) fn third_directional<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
+pub(crate) fn third_directional<K: DeformationKernel<NX, NE>, const NX: usize, const NE: usize>(
     k: &K,
     x: &[f64; NX],
     a: &[f64; NX],
@@ -54,7 +96,7 @@ pub(crate) fn third_directional<K: DefKernel<NX, NE>, const NX: usize, const NE:
 }
 
 /// The weighted Hessian Σᵢ wᵢ Dᵢ,xx (`NX × NX`).
-pub(crate) fn weighted_hessian<K: DefKernel<NX, NE>, const NX: usize, const NE: usize>(
+pub(crate) fn weighted_hessian<K: DeformationKernel<NX, NE>, const NX: usize, const NE: usize>(
     k: &K,
     x: &[f64; NX],
     w: &[f64; NE],
@@ -96,7 +138,7 @@ pub(crate) struct TwoNodeSpatial {
     pub bowing: bool,
 }
 
-impl DefKernel<14, 6> for TwoNodeSpatial {
+impl DeformationKernel<14, 6> for TwoNodeSpatial {
     #[inline]
     fn eval<T: Real>(&self, x: &[T; 14]) -> [T; 6] {
         let rp = vec3(x, 0);
@@ -147,7 +189,7 @@ pub(crate) struct PlanarBeamKernel {
     pub shortening: bool,
 }
 
-impl DefKernel<6, 3> for PlanarBeamKernel {
+impl DeformationKernel<6, 3> for PlanarBeamKernel {
     #[inline]
     fn eval<T: Real>(&self, x: &[T; 6]) -> [T; 3] {
         let dx = x[3] - x[0];
@@ -187,7 +229,7 @@ pub(crate) struct TrussKernel {
     pub l0: f64,
 }
 
-impl DefKernel<4, 1> for TrussKernel {
+impl DeformationKernel<4, 1> for TrussKernel {
     #[inline]
     fn eval<T: Real>(&self, x: &[T; 4]) -> [T; 1] {
         let dx = x[2] - x[0];
@@ -196,7 +238,7 @@ impl DefKernel<4, 1> for TrussKernel {
     }
 }
 
-impl DefKernel<6, 1> for TrussKernel {
+impl DeformationKernel<6, 1> for TrussKernel {
     #[inline]
     fn eval<T: Real>(&self, x: &[T; 6]) -> [T; 1] {
         let d = vec3(x, 3) - vec3(x, 0);
@@ -207,7 +249,7 @@ impl DefKernel<6, 1> for TrussKernel {
 /// The planar hinge of thesis (5.5): ε = φq − φp.
 pub(crate) struct PlanarHingeKernel;
 
-impl DefKernel<2, 1> for PlanarHingeKernel {
+impl DeformationKernel<2, 1> for PlanarHingeKernel {
     #[inline]
     fn eval<T: Real>(&self, x: &[T; 2]) -> [T; 1] {
         [x[1] - x[0]]
@@ -241,7 +283,7 @@ impl SpatialHingeKernel {
     }
 }
 
-impl DefKernel<8, 3> for SpatialHingeKernel {
+impl DeformationKernel<8, 3> for SpatialHingeKernel {
     #[inline]
     fn eval<T: Real>(&self, x: &[T; 8]) -> [T; 3] {
         let mp = rotation(&quat(x, 0));
@@ -260,7 +302,7 @@ impl DefKernel<8, 3> for SpatialHingeKernel {
 /// The Euler-parameter normalization as a rigid deformation: ε = (λᵀλ − 1)/2.
 pub(crate) struct NormalizationKernel;
 
-impl DefKernel<4, 1> for NormalizationKernel {
+impl DeformationKernel<4, 1> for NormalizationKernel {
     #[inline]
     fn eval<T: Real>(&self, x: &[T; 4]) -> [T; 1] {
         [(x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3] - 1.0) * 0.5]

@@ -18,6 +18,13 @@
 //! spatial beam (6.2), spatial truss, spatial hinge, point mass, rigid body,
 //! two-node superelement (chapters 2–3) and the Euler-parameter normalization.
 //!
+//! Your own element: implement [`DeformationKernel`] (ε = D(x) once over
+//! [`flexmb_dual::Real`]) and build it with [`Element::custom`]; its exact
+//! derivatives follow as for the built-ins, and
+//! `flexmb_model::Scene::build_with_elements` places it in a mechanism (see
+//! `docs/elements.md`, "Writing your own element", and
+//! `examples/custom_element.rs`). Built-in elements stay statically dispatched.
+//!
 //! ```
 //! use flexmb_element::{BeamOptions, Element, Material, SectionShape};
 //! let steel = Material::from_poisson(2.1e11, 0.3, 7800.0);
@@ -35,6 +42,7 @@
 #![warn(missing_docs)]
 
 mod beam_matrices;
+mod custom;
 mod element;
 mod inertia;
 mod kernels;
@@ -45,8 +53,10 @@ pub use beam_matrices::{
     equivalent_stiffness, planar_beam_m_bar, planar_beam_s_bar, shear_parameter, spatial_a_diag,
     spatial_beam_m_bar, spatial_beam_s_bar,
 };
+pub use custom::MAX_ELEMENT_COORDS;
 pub use element::{frame_from_axis, BeamOptions, Element, Slot, FLIP_ANGLE};
 pub use inertia::{VelocityTransform, MAX_MODES};
+pub use kernels::DeformationKernel;
 pub use section::{rectangle_torsion_constant, Material, SectionProperties, SectionShape};
 pub use superelement::{LinearSuperelement, ModeKind, Provenance, Side};
 
@@ -69,4 +79,17 @@ pub enum ElementError {
     /// Inconsistent superelement data.
     #[error("invalid superelement data: {0}")]
     Superelement(String),
+    /// A custom element with more coordinates or deformations than the
+    /// per-element buffers hold ([`MAX_ELEMENT_COORDS`]).
+    #[error("custom element '{element}' has {n} {what}, more than the {max} (MAX_ELEMENT_COORDS, the size of the largest built-in element) one element may have; split it into smaller elements")]
+    TooLarge {
+        /// The element's type name.
+        element: String,
+        /// "nodal coordinates" or "deformations".
+        what: &'static str,
+        /// How many it has.
+        n: usize,
+        /// The limit, [`MAX_ELEMENT_COORDS`].
+        max: usize,
+    },
 }

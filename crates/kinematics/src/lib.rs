@@ -511,7 +511,7 @@ impl Kinematics {
 
     fn eval_elements(&mut self, with_jac: bool) {
         let mech = &self.mech;
-        let mut xl = [0.0; 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (k, e) in mech.elements.iter().enumerate() {
             let m = &self.maps[k];
             if m.ne == 0 {
@@ -1263,8 +1263,8 @@ impl Kinematics {
     /// configuration and velocities (zero for elements at rest), the
     /// velocity-quadratic part of ε̈ = D,x ẍ + D,xx\[ẋ, ẋ\] (thesis (5.8b)).
     pub fn convective_terms(&mut self) -> &[f64] {
-        let mut xl = [0.0; 64];
-        let mut vl = [0.0; 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in self.mech.elements.iter().enumerate() {
             let m = &self.maps[ei];
             if m.ne == 0 {
@@ -1400,14 +1400,14 @@ impl Kinematics {
         let (n_q, n_x) = (self.n_q, mech.n_x());
         let n_c = mech.constraint_rows.len();
         let mut rhs = Mat::<f64>::zeros(n_c, n_q);
-        let mut xl = [0.0; 64];
-        let mut vl = [0.0; 64];
-        let mut al = [0.0; 64];
-        let mut fl = [0.0; 64];
-        let mut gl = [0.0; 64];
-        let mut o1 = [0.0; 64];
-        let mut o2 = [0.0; 64];
-        let mut o3 = [0.0; 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut al = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut gl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut o1 = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut o2 = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut o3 = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in mech.elements.iter().enumerate() {
             let m = &self.maps[ei];
             if m.ne == 0 || m.rows.iter().all(|r| r.is_none()) {
@@ -1491,10 +1491,10 @@ impl Kinematics {
         _unused: impl Fn(usize, usize) -> Option<f64>,
     ) {
         let n_q = self.n_q;
-        let mut xl = [0.0; 64];
-        let mut vl = [0.0; 64];
-        let mut fl = [0.0; 64];
-        let mut o = [0.0; 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut o = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in self.mech.elements.iter().enumerate() {
             let m = &self.maps[ei];
             if m.ne == 0 {
@@ -1566,10 +1566,11 @@ impl Kinematics {
         // HF = Σ_e scatter(H_e F_e), then G = F,qᵀ HF with one product
         let n_x = mech.n_x();
         let mut hf = Mat::<f64>::zeros(n_x, n_q);
-        let mut xl = [0.0; 64];
-        let mut wl = [0.0; 64];
-        let mut h = vec![0.0; 64 * 64];
-        let mut fl = [0.0; 64];
+        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut wl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+        let mut h =
+            vec![0.0; flexmb_element::MAX_ELEMENT_COORDS * flexmb_element::MAX_ELEMENT_COORDS];
+        let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in mech.elements.iter().enumerate() {
             let m = &self.maps[ei];
             if m.ne == 0 {

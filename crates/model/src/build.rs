@@ -164,8 +164,36 @@ fn position_of_cycle(nodes: &[NodeSpec]) -> Result<(), ModelError> {
     Ok(())
 }
 
+/// An element built in Rust code, for instance a user-defined element
+/// ([`Element::custom`]), placed between the nodes of a scene by
+/// [`Scene::build_with_elements`](crate::Scene::build_with_elements).
+#[derive(Clone, Debug)]
+pub struct CodeElement {
+    /// Unique id among the scene's elements: selections (`Def(id, name)`,
+    /// outputs) and messages use it, as for a scene element.
+    pub id: String,
+    /// The element.
+    pub element: Element,
+    /// One node id per slot of the element, in slot order: a
+    /// [`Slot::Position2`](flexmb_element::Slot)/`Position3` slot takes the
+    /// node's position, an `Angle`/`Orientation` slot its orientation (planar
+    /// angle or Euler parameters, allocated when an element needs it). Mode
+    /// slots are not supported here.
+    pub nodes: Vec<String>,
+}
+
 /// Assembles a scene. `base_dir` resolves relative superelement file paths.
 pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelError> {
+    build_with_elements(scene, base_dir, &[])
+}
+
+/// Assembles a scene with extra elements built in code, placed after the
+/// scene's own elements (see [`CodeElement`]).
+pub fn build_with_elements(
+    scene: &Scene,
+    base_dir: Option<&Path>,
+    extra: &[CodeElement],
+) -> Result<Mechanism, ModelError> {
     let dim = scene.dimension;
     let nd = match dim {
         Dimension::Planar => 2,
@@ -608,6 +636,60 @@ pub fn build(scene: &Scene, base_dir: Option<&Path>) -> Result<Mechanism, ModelE
                 });
             }
         }
+    }
+    for c in extra {
+        let ctx = format!("element '{}' (built in code)", c.id);
+        if c.id.is_empty() {
+            return Err(ModelError::invalid(ctx, "an empty id"));
+        }
+        if element_ids.insert(c.id.clone(), ()).is_some() {
+            return Err(ModelError::DuplicateId {
+                kind: "element",
+                id: c.id.clone(),
+            });
+        }
+        let slots = c.element.slots();
+        if c.nodes.len() != slots.len() {
+            return Err(ModelError::invalid(
+                ctx,
+                format!(
+                    "{} node ids given for the {} slots {slots:?}; give one node per slot",
+                    c.nodes.len(),
+                    slots.len()
+                ),
+            ));
+        }
+        let mut attach = vec![];
+        for (slot, n) in slots.iter().zip(&c.nodes) {
+            node_ref(n, &ctx, &node_at)?;
+            use flexmb_element::Slot;
+            let fits = match slot {
+                Slot::Position2 | Slot::Angle => dim == Dimension::Planar,
+                Slot::Position3 | Slot::Orientation => dim == Dimension::Spatial,
+                Slot::Modes(_) => {
+                    return Err(ModelError::invalid(
+                        ctx,
+                        "mode-amplitude slots are not supported for elements built in code",
+                    ))
+                }
+            };
+            if !fits {
+                return Err(ModelError::invalid(
+                    ctx,
+                    format!("a {slot:?} slot does not fit a {dim:?} scene"),
+                ));
+            }
+            attach.push(match slot {
+                Slot::Position2 | Slot::Position3 => Attach::Pos(n.clone()),
+                _ => Attach::Orient(n.clone()),
+            });
+        }
+        expanded.push(Expanded {
+            id: c.id.clone(),
+            group: c.id.clone(),
+            element: c.element.clone(),
+            attach,
+        });
     }
     if expanded.is_empty() {
         return Err(ModelError::invalid("scene", "has no elements"));

@@ -38,6 +38,7 @@ mod roles;
 mod scene;
 mod time_function;
 
+pub use build::CodeElement;
 pub use chart::{ChartSwitch, EulerChart, CHART_SWITCH_RATIO};
 pub use error::ModelError;
 pub use mechanism::*;
@@ -76,6 +77,20 @@ impl Scene {
     /// paths (superelement files).
     pub fn build(&self, base_dir: Option<&Path>) -> Result<Mechanism, ModelError> {
         build::build(self, base_dir)
+    }
+
+    /// [`build`](Self::build) with extra elements built in Rust code, e.g.
+    /// user-defined elements ([`flexmb_element::Element::custom`]) that a
+    /// scene file cannot name: each [`CodeElement`] gives the element, its
+    /// id and one node id per slot. The scene's selections (`fixed`, `rigid`,
+    /// `prescribed`, `dofs_first`, outputs) can name its deformations by that
+    /// id like those of any other element.
+    pub fn build_with_elements(
+        &self,
+        base_dir: Option<&Path>,
+        elements: &[CodeElement],
+    ) -> Result<Mechanism, ModelError> {
+        build::build_with_elements(self, base_dir, elements)
     }
 
     /// Writes the scene as pretty RON.
