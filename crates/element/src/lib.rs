@@ -23,7 +23,7 @@
 //! derivatives follow as for the built-ins, and
 //! `flexmb_model::Scene::build_with_elements` places it in a mechanism (see
 //! `docs/elements.md`, "Writing your own element", and
-//! `examples/custom_element.rs`). Built-in elements stay statically dispatched.
+//! `crates/flexmb/examples/custom_element.rs`). Built-in elements stay statically dispatched.
 //!
 //! ```
 //! use flexmb_element::{BeamOptions, Element, Material, SectionShape};

@@ -79,10 +79,11 @@
 //! * `superelement_from_fe`: a superelement built from FE matrices
 //!   assembled in code, its frequencies against the FE model's own;
 //! * `custom_basis`: a reduction basis of one's own through
-//!   [`Basis`](reduction::Basis).
-//!
-//! A custom element example follows when the element interface is public
-//! (issue 19 item 3).
+//!   [`Basis`](reduction::Basis);
+//! * `custom_element`: an element written outside the element crate
+//!   ([`element::DeformationKernel`], [`element::Element::custom`]), placed
+//!   in a mechanism built from a scene, its statics and eigenfrequencies
+//!   against the analytic values.
 #![warn(missing_docs)]
 
 /// The dense and sparse matrices of the system level (faer), as in
@@ -101,6 +102,9 @@ pub use flexmb_plot as plot;
 pub use flexmb_reduction as reduction;
 pub use flexmb_rotation as rotation;
 pub use flexmb_superelement as superelement;
+/// nalgebra, for the small fixed-size matrices of element code (an
+/// element's stiffness and mass in [`element::Element::custom`]).
+pub use nalgebra;
 
 /// The commonly used types of the layers: scenes and mechanisms, the
 /// equations of motion and their options, eigen-analyses, and reduced models

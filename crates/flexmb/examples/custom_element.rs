@@ -8,13 +8,13 @@
 //! hanging from the two rods and compares the vertical eigenfrequency with
 //! the analytic one. Exits non-zero if a check fails.
 //!
-//! Run with `cargo run --release -p flexmb-element --example custom_element`.
+//! Run with `cargo run --release -p flexmb --example custom_element`.
 
-use flexmb_dual::Real;
-use flexmb_dynamics::Dynamics;
-use flexmb_element::{DeformationKernel, Element, Slot};
-use flexmb_model::{CodeElement, Scene};
-use nalgebra::DMatrix;
+use flexmb::dual::Real;
+use flexmb::dynamics::Dynamics;
+use flexmb::element::{DeformationKernel, Element, Slot};
+use flexmb::model::{CodeElement, Scene};
+use flexmb::nalgebra::DMatrix;
 use std::process::ExitCode;
 use std::sync::Arc;
 
@@ -112,7 +112,7 @@ fn run() -> Result<u32, Box<dyn std::error::Error>> {
     // eigenfrequencies at the equilibrium: vertical and horizontal both
     // √(2 k cos²45° / m) = √(k/m), plus the small geometric-stiffness term
     let lin = dy.linearize_at_rest(0.0, &st.q)?;
-    let f = flexmb_linearize::undamped_modes(&lin, 2)?.frequencies_hz();
+    let f = flexmb::linearize::undamped_modes(&lin, 2)?.frequencies_hz();
     let f_expected = (k_rod / m).sqrt() / (2.0 * std::f64::consts::PI);
     println!("eigenfrequencies {f:?} Hz, analytic {f_expected:.6} Hz");
     check(
