@@ -19,6 +19,7 @@ mod path;
 mod reduce;
 mod reduced;
 mod report;
+mod vtk_out;
 
 use clap::{Args, Parser, Subcommand};
 use flexmb_dynamics::{
@@ -70,6 +71,10 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "results/static")]
         out: PathBuf,
+        /// Also write the equilibrium as VTK (static.pvd and a VTU file) to
+        /// this directory.
+        #[arg(long, value_name = "DIR")]
+        vtk: Option<PathBuf>,
     },
     /// Time response from the reference configuration (or from equilibrium with --static-first).
     Simulate(SimulateArgs),
@@ -132,6 +137,10 @@ struct SimulateArgs {
     /// Output directory.
     #[arg(long, default_value = "results/simulate")]
     out: PathBuf,
+    /// Also write the configuration at every output time as VTK
+    /// (simulate.pvd and one VTU file per output) to this directory.
+    #[arg(long, value_name = "DIR")]
+    vtk: Option<PathBuf>,
 }
 
 /// Options of `flexmb sweep`.
@@ -234,7 +243,8 @@ fn run(command: Command) -> Result<(), Failure> {
             time,
             steps,
             out,
-        } => statics(&scene, time, steps, &out),
+            vtk,
+        } => statics(&scene, time, steps, &out, vtk.as_deref()),
         Command::Simulate(a) => simulate(&a),
         Command::Eig {
             scene,
@@ -287,11 +297,20 @@ fn info(path: &Path) -> Result<(), Failure> {
 
 /// `flexmb static`: the equilibrium at time `t` in `steps` load increments,
 /// written to `out`.
-fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure> {
+fn statics(
+    path: &Path,
+    t: f64,
+    steps: usize,
+    out: &Path,
+    vtk: Option<&Path>,
+) -> Result<(), Failure> {
     options::finite("--time", t)?;
     options::at_least("--steps", steps, 1, "the number of load increments")?;
     let (_, mech) = load(path)?;
     options::writable_dir("--out", out)?;
+    if let Some(d) = vtk {
+        options::writable_dir("--vtk", d)?;
+    }
     let mut dy = Dynamics::new(mech.clone());
     let opts = StaticOptions {
         load_steps: steps,
@@ -352,6 +371,9 @@ fn statics(path: &Path, t: f64, steps: usize, out: &Path) -> Result<(), Failure>
     )
     .map_err(|e| io_err(e, &p))?;
     say!("wrote {}", out.display());
+    if let Some(d) = vtk {
+        vtk_out::write(d, "static", &mech, &[(t, &sol.x)])?;
+    }
     Ok(())
 }
 
@@ -370,6 +392,9 @@ fn simulate(a: &SimulateArgs) -> Result<(), Failure> {
     options::positive("--atol", a.atol)?;
     let (_, mech) = load(&a.scene)?;
     options::writable_dir("--out", &a.out)?;
+    if let Some(d) = &a.vtk {
+        options::writable_dir("--vtk", d)?;
+    }
     let mut opts = SimulationOptions::new(integrator, 0.0, a.t_end, a.outputs);
     opts.rtol = a.rtol;
     opts.atol = a.atol;
@@ -410,6 +435,23 @@ fn simulate(a: &SimulateArgs) -> Result<(), Failure> {
         comments.push(format!("interrupted: {p}"));
     }
     write_outputs(model.dynamics(), rows, &comments, &a.out)?;
+    if let Some(d) = &a.vtk {
+        if response.x.len() != response.t.len() {
+            return Err(Failure::Compute(format!(
+                "--vtk: the run recorded nodal coordinates at {} of its {} outputs",
+                response.x.len(),
+                response.t.len()
+            )));
+        }
+        // the nodal coordinates the integrator reached at each output
+        let frames: Vec<(f64, &[f64])> = response
+            .t
+            .iter()
+            .zip(&response.x)
+            .map(|(t, x)| (*t, x.as_slice()))
+            .collect();
+        vtk_out::write(d, "simulate", &mech, &frames)?;
+    }
     match partial {
         Some(p) => Err(Failure::Interrupted(format!(
             "partial results written: {p}"
