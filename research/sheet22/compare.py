@@ -7,7 +7,7 @@ import csv, sys
 def load(path):
     rows = {}
     for r in csv.reader(l for l in open(path) if not l.startswith("case")):
-        case, P, tx, ty, mode, f, kind = r[0] + "," + r[1] + "," + r[2] + "," + r[3], *r[4:]
+        P, tx, ty, mode, f, kind = r[-6:]
         rows.setdefault(float(P), {"tip": (float(tx), float(ty)), "in": [], "out": []})[kind].append(float(f))
     return rows
 

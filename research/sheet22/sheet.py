@@ -204,11 +204,12 @@ def run_solid(a):
     nn, ne = write_deck(job + ".inp", a.L, a.b, a.t, a.nl, a.nh, a.nt, a.mat, a.loads, a.modes, a.incs, a.clamp)
     print(f"# deck {job}.inp: {nn} nodes, {ne} C3D20R elements", file=sys.stderr)
     env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_EQUATION_SOLVER="1")
-    r = subprocess.run(["nice", "-n", "10", "ccx", "-i", "sheet"], cwd=a.out, env=env,
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    open(job + ".log", "w").write(r.stdout)
-    if "Job finished" not in r.stdout:
-        raise SystemExit(f"ccx failed, see {job}.log")
+    if not a.reuse:
+        r = subprocess.run(["nice", "-n", "10", "ccx", "-i", "sheet"], cwd=a.out, env=env,
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        open(job + ".log", "w").write(r.stdout)
+        if "Job finished" not in r.stdout:
+            raise SystemExit(f"ccx failed, see {job}.log")
     tips, freqs, parts = parse_dat(job + ".dat")
     case = f"solid,{a.mat},b/t={a.b / a.t:g},mesh={a.nl}x{a.nh}x{a.nt},clamp={a.clamp}"
     print("case,P,tip_x,tip_y,mode,f_Hz,kind")
@@ -323,6 +324,7 @@ def main():
     ap.add_argument("--incs", type=int, default=10)
     ap.add_argument("--sweep-n", type=int, default=11)
     ap.add_argument("--out", default="/tmp/sheet22")
+    ap.add_argument("--reuse", action="store_true", help="parse an existing sheet.dat in --out, do not run ccx")
     ap.add_argument("--clamp", choices=["full", "warpfree"], default="full",
                     help="solid clamp: all nodes fixed, or warping (u_y = c x z) left free")
     a = ap.parse_args()
