@@ -34,3 +34,5 @@ python3 research/sheet22/vlasov.py 0.015 0.0005 0.2 >> $R/vlasov_at_rest.txt
 # guidance (first draft deck), and flexmb at the same strokes
 python3 research/sheet22/guidance.py --xs 0,0.02,0.04,0.06,0.0834 --nl 50 --nh 8 --modes 8 --out /tmp/s22/guid_50x8 > $R/solid_guidance_nu0_50x8x2.csv
 python3 research/sheet22/guidance_beam.py > $R/beam_guidance_nu0.csv
+# guidance with the warping of the two base clamps freed (the body end stays rigid)
+python3 research/sheet22/guidance.py --clamp warpfree --xs 0.02,0.0834 --incs 6 --nl 50 --nh 8 --modes 8 --out /tmp/s22/guid_50x8_wf > $R/solid_guidance_nu0_50x8x2_warpfree.csv
