@@ -36,3 +36,8 @@ python3 research/sheet22/guidance.py --xs 0,0.02,0.04,0.06,0.0834 --nl 50 --nh 8
 python3 research/sheet22/guidance_beam.py > $R/beam_guidance_nu0.csv
 # guidance with the warping of the two base clamps freed (the body end stays rigid)
 python3 research/sheet22/guidance.py --clamp warpfree --xs 0.02,0.0834 --incs 6 --nl 50 --nh 8 --modes 8 --out /tmp/s22/guid_50x8_wf > $R/solid_guidance_nu0_50x8x2_warpfree.csv
+# twist shapes, clamped and warp-free, at rest and alpha = 1.5
+for c in full warpfree; do
+  python3 $S solid --edges --clamp $c --loads 0,1.5 --incs 10 --modes 6 --out /tmp/s22/edges_$c > $R/solid_t0.001_nu0_50x8x2_edges_$c.csv
+  python3 research/sheet22/twist.py /tmp/s22/edges_$c > $R/twist_t0.001_nu0_50x8x2_$c.csv
+done

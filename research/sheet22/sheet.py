@@ -108,7 +108,7 @@ def material_cards(mat):
     raise SystemExit(f"unknown material {mat}")
 
 
-def write_deck(path, L, b, t, nl, nh, nt, mat, loads, nmodes, incs, clamp_kind="full"):
+def write_deck(path, L, b, t, nl, nh, nt, mat, loads, nmodes, incs, clamp_kind="full", edges_out=False):
     nodes, elems, nid, dims = mesh(L, b, t, nl, nh, nt)
     NI, NJ, NK = dims
     clamp = [n for (i, j, k), n in nid.items() if i == 0]
@@ -124,6 +124,10 @@ def write_deck(path, L, b, t, nl, nh, nt, mat, loads, nmodes, incs, clamp_kind="
     out.append("*NSET,NSET=CLAMP")
     out += [",".join(map(str, clamp[i:i + 16])) for i in range(0, len(clamp), 16)]
     out.append(f"*NSET,NSET=TIPC\n{tipc}")
+    # mid-thickness nodes on the top and bottom edges, for mode shapes (twist along s)
+    edges = [nid[(i, j, (NK - 1) // 2)] for i in range(0, NI, 2) for j in (0, NJ - 1)]
+    out.append("*NSET,NSET=EDGES")
+    out += [",".join(map(str, edges[i:i + 16])) for i in range(0, len(edges), 16)]
     out.append("*MATERIAL,NAME=STEEL")
     out.append(material_cards(mat).rstrip())
     out.append(f"*DENSITY\n{RHO}")
@@ -157,9 +161,13 @@ def write_deck(path, L, b, t, nl, nh, nt, mat, loads, nmodes, incs, clamp_kind="
         for n, f in w.items():
             out.append(f"{n},1,{P * f:.9e}")
         out.append("*NODE PRINT,NSET=TIPC\nU")
+        if edges_out:
+            out.append("*NODE PRINT,NSET=EDGES\nU")
         out.append("*END STEP")
         out.append("*STEP,PERTURBATION")
         out.append(f"*FREQUENCY\n{nmodes}")
+        if edges_out:
+            out.append("*NODE PRINT,NSET=EDGES\nU")
         out.append("*END STEP")
     with open(path, "w") as fh:
         fh.write("\n".join(out) + "\n")
@@ -174,7 +182,7 @@ def parse_dat(path):
     tips, freqs, parts = [], [], []
     last_tip = None
     for bl in blocks:
-        if bl.startswith("displacements"):
+        if bl.startswith("displacements") and "for set TIPC" in bl.splitlines()[0]:
             line = [l for l in bl.splitlines()[1:] if l.strip()][0]
             v = line.split()
             last_tip = (float(v[1]), float(v[2]), float(v[3]))
@@ -201,7 +209,7 @@ def parse_dat(path):
 def run_solid(a):
     os.makedirs(a.out, exist_ok=True)
     job = os.path.join(a.out, "sheet")
-    nn, ne = write_deck(job + ".inp", a.L, a.b, a.t, a.nl, a.nh, a.nt, a.mat, a.loads, a.modes, a.incs, a.clamp)
+    nn, ne = write_deck(job + ".inp", a.L, a.b, a.t, a.nl, a.nh, a.nt, a.mat, a.loads, a.modes, a.incs, a.clamp, a.edges)
     print(f"# deck {job}.inp: {nn} nodes, {ne} C3D20R elements", file=sys.stderr)
     env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_EQUATION_SOLVER="1")
     if not a.reuse:
@@ -324,6 +332,7 @@ def main():
     ap.add_argument("--incs", type=int, default=10)
     ap.add_argument("--sweep-n", type=int, default=11)
     ap.add_argument("--out", default="/tmp/sheet22")
+    ap.add_argument("--edges", action="store_true", help="also print U of the edge nodes (static state and modes) to sheet.dat, for twist.py")
     ap.add_argument("--reuse", action="store_true", help="parse an existing sheet.dat in --out, do not run ccx")
     ap.add_argument("--clamp", choices=["full", "warpfree"], default="full",
                     help="solid clamp: all nodes fixed, or warping (u_y = c x z) left free")
