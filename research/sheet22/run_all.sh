@@ -41,3 +41,5 @@ for c in full warpfree; do
   python3 $S solid --edges --clamp $c --loads 0,1.5 --incs 10 --modes 6 --out /tmp/s22/edges_$c > $R/solid_t0.001_nu0_50x8x2_edges_$c.csv
   python3 research/sheet22/twist.py /tmp/s22/edges_$c > $R/twist_t0.001_nu0_50x8x2_$c.csv
 done
+# guidance, fine mesh (about 15 min on one core)
+python3 research/sheet22/guidance.py --xs 0.04,0.0834 --incs 5 --nl 100 --nh 16 --modes 6 --out /tmp/s22/guid_100x16 > $R/solid_guidance_nu0_100x16x2.csv
