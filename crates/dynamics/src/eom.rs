@@ -624,18 +624,10 @@ impl Dynamics {
         let bad: Vec<usize> = (index..values.len())
             .filter(|k| !values[*k].is_finite())
             .collect();
-        let mut names: Vec<String> = bad
-            .iter()
-            .take(3)
-            .map(|k| self.mech.dof_label(*k))
-            .collect();
-        if bad.len() > 3 {
-            names.push(format!("{} more", bad.len() - 3));
-        }
         DynamicsError::NonFinite {
             what,
             index,
-            name: names.join(", "),
+            name: flexmb_model::list_some(&bad, |k| self.mech.dof_label(k)),
             t,
         }
     }

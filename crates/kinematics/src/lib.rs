@@ -656,18 +656,10 @@ impl Kinematics {
         if let Some(i) = q.iter().position(|v| !v.is_finite()) {
             // every non-finite entry (up to three by name), not just the first
             let bad: Vec<usize> = (i..q.len()).filter(|&k| !q[k].is_finite()).collect();
-            let mut names: Vec<String> = bad
-                .iter()
-                .take(3)
-                .map(|&k| self.mech.dof_label(k))
-                .collect();
-            if bad.len() > 3 {
-                names.push(format!("{} more", bad.len() - 3));
-            }
             return Err(KinematicsError::NonFinite {
                 what: "q",
                 index: i,
-                name: names.join(", "),
+                name: flexmb_model::list_some(&bad, |k| self.mech.dof_label(k)),
             });
         }
         let n_u = self.n_u;

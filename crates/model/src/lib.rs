@@ -45,6 +45,16 @@ pub use mechanism::*;
 pub use scene::*;
 pub use time_function::TimeFunction;
 
+/// The first three of `bad` by name (`name` of each index) and a count of
+/// the rest, comma-separated: how errors list the entries at fault.
+pub fn list_some(bad: &[usize], name: impl Fn(usize) -> String) -> String {
+    let mut names: Vec<String> = bad.iter().take(3).map(|&k| name(k)).collect();
+    if bad.len() > 3 {
+        names.push(format!("{} more", bad.len() - 3));
+    }
+    names.join(", ")
+}
+
 use std::path::Path;
 
 /// Parses RON text, reporting line and column of a syntax error, and for an
