@@ -41,13 +41,15 @@ impl Model {
 
     /// A fresh instance of the model: the unreduced dynamics or the reduced
     /// model over its basis, behind the one interface of both.
-    pub fn instance(&self) -> Box<dyn MechanicalModel> {
+    pub fn instance(&self) -> Result<Box<dyn MechanicalModel>, String> {
         let b: Box<dyn Basis> = match &self.kind {
-            ModelKind::Unreduced => return Box::new(Dynamics::new(self.mech.clone())),
+            ModelKind::Unreduced => return Ok(Box::new(Dynamics::new(self.mech.clone()))),
             ModelKind::Fixed(b) => Box::new(b.clone()),
             ModelKind::Interpolated(b) => b.clone(),
         };
-        Box::new(ReducedModel::new(self.mech.clone(), b))
+        let reduced =
+            ReducedModel::new(self.mech.clone(), b).map_err(|e| format!("{}: {e}", self.name))?;
+        Ok(Box::new(reduced))
     }
 
     /// Number of coordinates integrated (n_q or n_z).
@@ -117,7 +119,7 @@ pub fn quasi_static_curve(
 ) -> Result<Vec<CurvePoint>, String> {
     let ctx = |e: flexmb_reduction::ReductionError| format!("{}: {e}", model.name);
     let probe = NodeProbe::new(&model.mech, node)?;
-    let mut m = model.instance();
+    let mut m = model.instance()?;
     // all frequencies, for the highest; a reduced model keeps all of them
     let all = m.n_coordinates();
     let keep = if m.is_reduced() { all } else { count };
@@ -179,7 +181,7 @@ pub fn simulate(
         opts.atol
     );
     let probe = NodeProbe::new(&model.mech, node)?;
-    let mut m = model.instance();
+    let mut m = model.instance()?;
     // the static equilibrium at t0 under the full loads, from the reference
     m.set_load_scale(1.0);
     let reference = m.reference_coordinates();
@@ -224,7 +226,7 @@ pub fn frequencies_along(
     count: usize,
 ) -> Result<Vec<f64>, String> {
     let t = r.t[i];
-    let mut m = model.instance();
+    let mut m = model.instance()?;
     // the position solve starts at the configuration of the response there
     m.dynamics_mut().kinematics_mut().set_guess(&r.x[i]);
     let c = r.z.as_ref().map_or(&r.q[i], |z| &z[i]);

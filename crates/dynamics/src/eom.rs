@@ -294,6 +294,21 @@ impl Dynamics {
     }
 
     /// Solves the kinematics to first order (and velocities, accelerations if asked).
+    /// `Ok` if a slice argument `what` of length `len` has one entry per
+    /// DOF; the length rule of the public API (docs/ARCHITECTURE.md): a
+    /// function that returns a `Result` reports a wrong length as
+    /// [`DynamicsError::Invalid`], it does not panic or truncate.
+    pub(crate) fn check_length(&self, what: &str, len: usize) -> Result<(), DynamicsError> {
+        if len == self.n_q() {
+            Ok(())
+        } else {
+            Err(DynamicsError::Invalid(format!(
+                "{what} has {len} entries, but the mechanism has {} degrees of freedom",
+                self.n_q()
+            )))
+        }
+    }
+
     pub(crate) fn kinematics_at(
         &mut self,
         t: f64,
@@ -305,6 +320,7 @@ impl Dynamics {
             .map_err(|e| DynamicsError::Kinematics { t, source: e })?;
         self.kin.first_order();
         if let Some(qd) = qd {
+            self.check_length("q̇", qd.len())?;
             if let Some(i) = qd.iter().position(|v| !v.is_finite()) {
                 return Err(self.non_finite("q̇", qd, i, t));
             }
@@ -497,6 +513,7 @@ impl Dynamics {
     ) -> Result<(), DynamicsError> {
         self.evaluations += 1;
         let n = self.n_q();
+        self.check_length("q̈", qdd.len())?;
         if !self.nodal_accelerations(t, q, qd, &mut qdd[..n])? {
             return self.accelerations_by_projection(t, q, qd, qdd);
         }
@@ -516,6 +533,7 @@ impl Dynamics {
     ) -> Result<bool, DynamicsError> {
         let kin_err = |e| DynamicsError::Kinematics { t, source: e };
         self.kin.solve_chord(q, t).map_err(kin_err)?;
+        self.check_length("q̇", qd.len())?;
         if let Some(i) = qd.iter().position(|v| !v.is_finite()) {
             return Err(self.non_finite("q̇", qd, i, t));
         }
@@ -694,6 +712,8 @@ impl Dynamics {
         qdd: &[f64],
         g: &mut [f64],
     ) -> Result<(), DynamicsError> {
+        self.check_length("q̈", qdd.len())?;
+        self.check_length("g", g.len())?;
         self.kinematics_at(t, q, Some(qd))?;
         self.forces(t, true);
         self.inertia(true);

@@ -2,7 +2,7 @@
 //! comes with the last evaluation that failed (the coordinates and equations
 //! the position solve could not satisfy), for every integrator.
 
-use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions};
+use flexmb_dynamics::{Control, Dynamics, DynamicsError, Integrator, SimulationOptions};
 use flexmb_model::Scene;
 use std::sync::Arc;
 
@@ -247,4 +247,41 @@ fn a_massless_degree_of_freedom_is_named_by_every_integrator() {
             "{integrator:?}: {e}"
         );
     }
+}
+
+#[test]
+fn slices_of_the_wrong_length_are_errors_naming_the_argument() {
+    // the length rule of the public API (docs/ARCHITECTURE.md): no panic,
+    // no silent truncation
+    let mut dy = Dynamics::new(free_mass(1.0, 1.0));
+    let mut qdd = [0.0; 2];
+    let cases: [(&str, Result<(), DynamicsError>); 4] = [
+        (
+            "q has 3 entries",
+            dy.accelerations(0.0, &[0.0; 3], &[0.0; 2], &mut qdd),
+        ),
+        (
+            "q̇ has 1 entries",
+            dy.accelerations(0.0, &[0.0; 2], &[0.0; 1], &mut qdd),
+        ),
+        (
+            "q̈ has 3 entries",
+            dy.accelerations(0.0, &[0.0; 2], &[0.0; 2], &mut [0.0; 3]),
+        ),
+        (
+            "q̇ has 4 entries",
+            dy.energies(0.0, &[0.0; 2], &[0.0; 4]).map(|_| ()),
+        ),
+    ];
+    for (expected, r) in cases {
+        let msg = r.expect_err(expected).to_string();
+        assert!(
+            msg.contains(expected) && msg.contains(" 2"),
+            "{expected}: {msg}"
+        );
+    }
+    // the right lengths still work
+    dy.accelerations(0.0, &[0.0; 2], &[0.0; 2], &mut qdd)
+        .unwrap();
+    assert_eq!(qdd, [0.0, 1.0]);
 }

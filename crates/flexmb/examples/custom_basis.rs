@@ -101,7 +101,8 @@ fn main() -> ExitCode {
 
     let mut full = Dynamics::new(mech.clone());
     let v = ritz_vectors(&mut full, 0.05, &q0);
-    let mut reduced = ReducedModel::new(mech.clone(), Box::new(RitzBasis { q0: q0.clone(), v }));
+    let mut reduced = ReducedModel::new(mech.clone(), Box::new(RitzBasis { q0: q0.clone(), v }))
+        .expect("the Ritz basis fits the mechanism");
 
     let f_full = full.eigenfrequencies(0.0, &q0, 2).expect("unreduced modes");
     let z0 = reduced.reference_coordinates();

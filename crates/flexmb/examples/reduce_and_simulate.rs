@@ -53,7 +53,8 @@ fn main() -> ExitCode {
 
     let (full, full_evals) =
         response(&mut Dynamics::new(mech.clone()), xs, x_ref).expect("unreduced run");
-    let mut reduced = ReducedModel::new(mech.clone(), Box::new(svd.basis));
+    let mut reduced =
+        ReducedModel::new(mech.clone(), Box::new(svd.basis)).expect("the reduced model");
     let (red, red_evals) = response(&mut reduced, xs, x_ref).expect("reduced run");
 
     let stroke = full.iter().fold(0.0f64, |m, v| m.max(v.abs()));

@@ -32,7 +32,7 @@
 //!
 //! // reduce: the three lowest modes at the equilibrium (MODAL-3)
 //! let basis = modal_basis(&mech, 0.0, &eq.coordinates, 3, None)?;
-//! let mut reduced = ReducedModel::new(mech.clone(), Box::new(basis));
+//! let mut reduced = ReducedModel::new(mech.clone(), Box::new(basis))?;
 //! let f_red = reduced.eigenfrequencies(0.0, &reduced.reference_coordinates(), 3)?;
 //! for (r, f) in f_red.iter().zip(&f_full) {
 //!     assert!((r / f - 1.0).abs() < 1e-8); // a modal basis keeps its modes' frequencies

@@ -134,6 +134,16 @@ pub enum KinematicsError {
         /// Its value.
         value: f64,
     },
+    /// An input slice of the wrong length (a caller's error).
+    #[error("{what} has {got} entries, but this mechanism has {expected}")]
+    Length {
+        /// Which input.
+        what: &'static str,
+        /// The length this mechanism needs.
+        expected: usize,
+        /// The length given.
+        got: usize,
+    },
     /// Non-finite input.
     #[error("non-finite value in {what}: {name}")]
     NonFinite {
@@ -201,6 +211,8 @@ pub struct Kinematics {
     iterations: usize,
     x_good: Vec<f64>,
     xi_good: Vec<f64>,
+    /// The target ξ = (q, u) of the current solve.
+    xi_target: Vec<f64>,
     lu_valid: bool,
     /// The factorization of J is of the current x (not of an earlier one).
     lu_at_x: bool,
@@ -363,6 +375,7 @@ impl Kinematics {
             iterations: 0,
             x_good: mech.x0.clone(),
             xi_good: vec![0.0; n_xi],
+            xi_target: vec![0.0; n_xi],
             lu_valid: false,
             lu_at_x: false,
             factorizations: 0,
@@ -653,6 +666,13 @@ impl Kinematics {
     }
 
     fn solve_inner(&mut self, q: &[f64], t: f64, mode: Refactor) -> Result<(), KinematicsError> {
+        if q.len() != self.n_q {
+            return Err(KinematicsError::Length {
+                what: "q",
+                expected: self.n_q,
+                got: q.len(),
+            });
+        }
         if let Some(i) = q.iter().position(|v| !v.is_finite()) {
             // every non-finite entry (up to three by name), not just the first
             let bad: Vec<usize> = (i..q.len()).filter(|&k| !q[k].is_finite()).collect();
@@ -662,13 +682,22 @@ impl Kinematics {
                 name: flexmb_model::list_some(&bad, |k| self.mech.dof_label(k)),
             });
         }
-        let n_u = self.n_u;
-        let mut target = q.to_vec();
-        for k in 0..n_u {
-            target.push(self.mech.inputs[k].function.value(t));
+        // ξ = (q, u) in a buffer kept between solves (no allocation per solve)
+        let mut target = std::mem::take(&mut self.xi_target);
+        target[..self.n_q].copy_from_slice(q);
+        for k in 0..self.n_u {
+            target[self.n_q + k] = self.mech.inputs[k].function.value(t);
         }
         self.t = t;
-        let first = self.solve_xi(&target, mode);
+        let r = self.solve_to(&target, mode);
+        self.xi_target = target;
+        r
+    }
+
+    /// [`solve_inner`](Self::solve_inner) for the full target ξ: one Newton
+    /// solve, then a continuation from the last converged ξ if that fails.
+    fn solve_to(&mut self, target: &[f64], mode: Refactor) -> Result<(), KinematicsError> {
+        let first = self.solve_xi(target, mode);
         if first.is_ok() || matches!(first, Err(KinematicsError::EulerParameterDegenerate { .. })) {
             return first;
         }
@@ -685,7 +714,7 @@ impl Kinematics {
                 let s = j as f64 / n as f64;
                 let mid: Vec<f64> = start
                     .iter()
-                    .zip(&target)
+                    .zip(target)
                     .map(|(a, b)| a + s * (b - a))
                     .collect();
                 // intermediate solutions feed the F,ξ predictor: J at each

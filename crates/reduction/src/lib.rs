@@ -29,7 +29,7 @@
 //! let mech = Arc::new(scene.build(None).unwrap());
 //! // the first three modes at rest (MODAL-3 of thesis §5.4.1)
 //! let basis = flexmb_reduction::modal_basis(&mech, 0.0, &mech.q0(), 3, None).unwrap();
-//! let mut red = ReducedModel::new(mech.clone(), Box::new(basis));
+//! let mut red = ReducedModel::new(mech.clone(), Box::new(basis)).unwrap();
 //! let mut zdd = vec![0.0; 3];
 //! red.accelerations(0.05, &[0.0; 3], &[0.0; 3], &mut zdd).unwrap();
 //! assert!(zdd.iter().any(|v| v.abs() > 0.0)); // the force pulse drives the reduced model

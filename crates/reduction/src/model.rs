@@ -26,9 +26,27 @@ pub struct ReducedModel {
 
 impl ReducedModel {
     /// A reduced model of `mech` with the given basis.
-    pub fn new(mech: Arc<Mechanism>, basis: Box<dyn Basis>) -> Self {
+    ///
+    /// # Errors
+    ///
+    /// [`ReductionError::Invalid`] when the basis does not fit the mechanism:
+    /// its n_q differs from the mechanism's number of DOFs, it has no reduced
+    /// coordinate, or more reduced coordinates than full ones (then Mz (6.15)
+    /// is singular).
+    pub fn new(mech: Arc<Mechanism>, basis: Box<dyn Basis>) -> Result<Self, ReductionError> {
         let (nq, nz) = (basis.n_q(), basis.n_z());
-        Self {
+        if nq != mech.n_dof() {
+            return Err(ReductionError::Invalid(format!(
+                "the basis maps to {nq} full coordinates but the mechanism has {} degrees of freedom",
+                mech.n_dof()
+            )));
+        }
+        if nz == 0 || nz > nq {
+            return Err(ReductionError::Invalid(format!(
+                "the basis has {nz} reduced coordinates; a reduced model needs between 1 and n_q = {nq}"
+            )));
+        }
+        Ok(Self {
             dy: Dynamics::new(mech),
             q: vec![0.0; nq],
             qd: vec![0.0; nq],
@@ -39,11 +57,30 @@ impl ReducedModel {
             mz: Mat::zeros(nz, nz),
             fz: Mat::zeros(nz, 1),
             basis,
-        }
+        })
     }
     /// Number of reduced coordinates.
     pub fn n_z(&self) -> usize {
         self.basis.n_z()
+    }
+    /// `Ok` if every named slice argument has n_z entries: the length rule of
+    /// the public API (docs/ARCHITECTURE.md) for functions returning a
+    /// `Result`.
+    fn check_reduced(&self, args: &[(&str, usize)]) -> Result<(), ReductionError> {
+        let nz = self.basis.n_z();
+        match args.iter().find(|(_, len)| *len != nz) {
+            None => Ok(()),
+            Some((what, len)) => Err(ReductionError::Invalid(format!(
+                "{what} has {len} entries, but the reduced model has {nz} coordinates"
+            ))),
+        }
+    }
+    /// Panics with a message naming `function` unless every slice has n_z
+    /// entries: the length rule for functions without a `Result`.
+    fn assert_reduced(&self, function: &str, args: &[(&str, usize)]) {
+        if let Err(e) = self.check_reduced(args) {
+            panic!("ReducedModel::{function}: {e}");
+        }
     }
     /// Scales the scene's loads (see `Dynamics::set_load_scale`).
     pub fn set_load_scale(&mut self, s: f64) {
@@ -58,7 +95,12 @@ impl ReducedModel {
         &mut self.dy
     }
     /// q = G(z).
+    ///
+    /// # Panics
+    ///
+    /// If `z` does not have [`n_z`](Self::n_z) entries.
     pub fn full_coordinates(&mut self, z: &[f64]) -> Vec<f64> {
+        self.assert_reduced("full_coordinates", &[("z", z.len())]);
         let zd = vec![0.0; z.len()];
         self.basis
             .eval(z, &zd, &mut self.q, &mut self.gz, &mut self.conv);
@@ -67,7 +109,12 @@ impl ReducedModel {
 
     /// q = G(z) and q̇ = G,z ż: the unreduced state of a reduced state, e.g.
     /// to record the scene's outputs along a reduced trajectory.
+    ///
+    /// # Panics
+    ///
+    /// If `z` or `zd` does not have [`n_z`](Self::n_z) entries.
     pub fn full_state(&mut self, z: &[f64], zd: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        self.assert_reduced("full_state", &[("z", z.len()), ("ż", zd.len())]);
         self.basis
             .eval(z, zd, &mut self.q, &mut self.gz, &mut self.conv);
         let qd = (0..self.q.len())
@@ -122,6 +169,7 @@ impl ReducedModel {
         zd: &[f64],
         zdd: &mut [f64],
     ) -> Result<(), ReductionError> {
+        self.check_reduced(&[("z", z.len()), ("ż", zd.len()), ("z̈", zdd.len())])?;
         let nz = self.basis.n_z();
         self.basis
             .eval(z, zd, &mut self.q, &mut self.gz, &mut self.conv);
@@ -181,6 +229,7 @@ impl ReducedModel {
         t: f64,
         z: &[f64],
     ) -> Result<(Mat<f64>, Mat<f64>), ReductionError> {
+        self.check_reduced(&[("z", z.len())])?;
         let nz = self.basis.n_z();
         self.basis
             .eval(z, &vec![0.0; nz], &mut self.q, &mut self.gz, &mut self.conv);
@@ -208,6 +257,7 @@ impl ReducedModel {
         t: f64,
         z: &[f64],
     ) -> Result<(Vec<f64>, Mat<f64>), ReductionError> {
+        self.check_reduced(&[("z", z.len())])?;
         let nz = self.basis.n_z();
         self.basis
             .eval(z, &vec![0.0; nz], &mut self.q, &mut self.gz, &mut self.conv);
@@ -320,6 +370,7 @@ impl ReducedModel {
         zd: &[f64],
         zdd: &[f64],
     ) -> Result<Vec<f64>, ReductionError> {
+        self.check_reduced(&[("z", z.len()), ("ż", zd.len()), ("z̈", zdd.len())])?;
         let (q, qd, qdd) = self.full_motion(z, zd, zdd);
         let mut g = vec![0.0; q.len()];
         self.dy.residual(t, &q, &qd, &qdd, &mut g)?;
@@ -369,6 +420,7 @@ impl ReducedModel {
         zd: &[f64],
         zdd: &[f64],
     ) -> Result<ReducedLinearization, ReductionError> {
+        self.check_reduced(&[("z", z.len()), ("ż", zd.len()), ("z̈", zdd.len())])?;
         let (q, qd, qdd) = self.full_motion(z, zd, zdd);
         let mut g = vec![0.0; q.len()];
         self.dy.residual(t, &q, &qd, &qdd, &mut g)?;

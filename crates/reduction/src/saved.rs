@@ -204,6 +204,6 @@ impl SavedModel {
     /// The reduced model of `mech`.
     pub fn into_model(&self, mech: Arc<Mechanism>) -> Result<ReducedModel, ReductionError> {
         let b = self.basis_for(&mech)?;
-        Ok(ReducedModel::new(mech, b))
+        ReducedModel::new(mech, b)
     }
 }

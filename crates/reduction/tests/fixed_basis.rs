@@ -70,7 +70,7 @@ fn identity_basis_reproduces_the_unreduced_trajectory_and_frequencies() {
             &Output::Times(times.clone()),
         )
         .unwrap();
-    let mut red = ReducedModel::new(mech.clone(), Box::new(basis.clone()));
+    let mut red = ReducedModel::new(mech.clone(), Box::new(basis.clone())).unwrap();
     let sol = Dopri5::new(o)
         .solve(&mut red, 0.0, &vec![0.0; 2 * n], 0.2, &Output::Times(times))
         .unwrap();
@@ -124,7 +124,7 @@ fn modal_basis_keeps_its_eigenfrequencies() {
         assert!((a / b - 1.0).abs() < 1e-9, "{a} vs {b}");
     }
     // the reduced model integrates: the pulse moves the body
-    let mut red = ReducedModel::new(mech.clone(), Box::new(basis));
+    let mut red = ReducedModel::new(mech.clone(), Box::new(basis)).unwrap();
     let sol = Dopri5::new(Dopri5Options::default())
         .solve(&mut red, 0.0, &[0.0; 6], 0.2, &Output::Final)
         .unwrap();
@@ -173,7 +173,7 @@ fn full_state_and_velocity_projection_invert_each_other_on_the_basis() {
     let mech = planar_guidance();
     let b = modal_basis(&mech, 0.0, &mech.q0(), 3, None).unwrap();
     let v = b.v.clone();
-    let mut red = ReducedModel::new(mech.clone(), Box::new(b));
+    let mut red = ReducedModel::new(mech.clone(), Box::new(b)).unwrap();
     let (z, zd) = ([0.01, -0.002, 0.003], [0.5, 0.2, -0.1]);
     let (q, qd) = red.full_state(&z, &zd);
     for i in 0..q.len() {
@@ -194,4 +194,54 @@ fn full_state_and_velocity_projection_invert_each_other_on_the_basis() {
     // a coordinate listed twice as large is refused
     let e = modal_basis(&mech, 0.0, &mech.q0(), 2, Some(&[1, 1])).unwrap_err();
     assert!(e.to_string().contains("listed twice"), "{e}");
+}
+
+#[test]
+fn a_basis_that_does_not_fit_and_slices_of_the_wrong_length_are_errors() {
+    let mech = planar_guidance();
+    let n = mech.n_dof();
+    // a basis for another mechanism (one coordinate too many)
+    let wrong = FixedBasis {
+        q0: vec![0.0; n + 1],
+        v: Mat::identity(n + 1, 2),
+    };
+    let msg = ReducedModel::new(mech.clone(), Box::new(wrong))
+        .err()
+        .expect("a basis of the wrong size")
+        .to_string();
+    assert!(
+        msg.contains(&format!("{}", n + 1)) && msg.contains(&format!("{n} degrees of freedom")),
+        "{msg}"
+    );
+    let empty = FixedBasis {
+        q0: mech.q0(),
+        v: Mat::zeros(n, 0),
+    };
+    let msg = ReducedModel::new(mech.clone(), Box::new(empty))
+        .err()
+        .expect("a basis without reduced coordinates")
+        .to_string();
+    assert!(msg.contains("0 reduced coordinates"), "{msg}");
+
+    let basis = FixedBasis {
+        q0: mech.q0(),
+        v: Mat::identity(n, 2),
+    };
+    let mut red = ReducedModel::new(mech.clone(), Box::new(basis)).unwrap();
+    let mut zdd = [0.0; 2];
+    let msg = red
+        .accelerations(0.0, &[0.0; 3], &[0.0; 2], &mut zdd)
+        .expect_err("z of length 3")
+        .to_string();
+    assert!(
+        msg.contains("z has 3 entries") && msg.contains("2 coordinates"),
+        "{msg}"
+    );
+    let msg = red
+        .linearize_at_rest(0.0, &[0.0; 1])
+        .expect_err("z of length 1")
+        .to_string();
+    assert!(msg.contains("z has 1 entries"), "{msg}");
+    red.accelerations(0.0, &[0.0; 2], &[0.0; 2], &mut zdd)
+        .unwrap();
 }

@@ -201,7 +201,7 @@ fn ibm_from_unconstrained_eigenvectors_reproduces_the_frequencies_at_its_nodes()
         SubspaceInterpolation::Msi,
     )
     .unwrap();
-    let mut red = ReducedModel::new(mech.clone(), Box::new(basis));
+    let mut red = ReducedModel::new(mech.clone(), Box::new(basis)).unwrap();
     for (k, pt) in pts.iter().enumerate() {
         let mut dy = Dynamics::new(mech.clone());
         dy.set_load_scale(0.1 * k as f64);

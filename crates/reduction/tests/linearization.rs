@@ -95,7 +95,7 @@ fn interpolated_basis_linearization_matches_differences_of_the_reduced_residual(
     let mech = nodal_guidance();
     let b = ibm(&mech);
     let s0 = mech.q0()[0] + 0.021;
-    let mut model = ReducedModel::new(mech, Box::new(b));
+    let mut model = ReducedModel::new(mech, Box::new(b)).unwrap();
     check(
         &mut model,
         0.05,
@@ -109,7 +109,7 @@ fn interpolated_basis_linearization_matches_differences_of_the_reduced_residual(
 fn fixed_basis_linearization_matches_differences_of_the_reduced_residual() {
     let mech = nodal_guidance();
     let b = modal_basis(&mech, 0.0, &mech.q0(), 3, None).unwrap();
-    let mut model = ReducedModel::new(mech, Box::new(b));
+    let mut model = ReducedModel::new(mech, Box::new(b)).unwrap();
     check(
         &mut model,
         0.05,
@@ -123,7 +123,7 @@ fn fixed_basis_linearization_matches_differences_of_the_reduced_residual() {
 fn at_rest_in_equilibrium_the_linearization_is_the_rest_form() {
     let mech = nodal_guidance();
     let b = ibm(&mech);
-    let mut model = ReducedModel::new(mech.clone(), Box::new(b));
+    let mut model = ReducedModel::new(mech.clone(), Box::new(b)).unwrap();
     let z0 = model.basis().z_reference();
     let z = model
         .newton_equilibrium(0.0, &[z0[0] + 0.02, 0.0, 0.0], &[0])

@@ -43,7 +43,7 @@ fn fixed_model_round_trip_keeps_frequencies_and_refuses_other_dofs() {
     saved.save(&path).unwrap();
     let loaded = SavedModel::load(&path).unwrap();
     std::fs::remove_file(&path).ok();
-    let mut before = ReducedModel::new(mech.clone(), Box::new(b));
+    let mut before = ReducedModel::new(mech.clone(), Box::new(b)).unwrap();
     let mut after = loaded.into_model(mech.clone()).unwrap();
     let f0 = before.frequencies_at_rest(0.0, &[0.0; 3]).unwrap();
     let f1 = after.frequencies_at_rest(0.0, &[0.0; 3]).unwrap();
@@ -82,7 +82,7 @@ fn interpolated_model_round_trip_keeps_configurations_and_frequencies() {
     saved.save(&path).unwrap();
     let loaded = SavedModel::load(&path).unwrap();
     std::fs::remove_file(&path).ok();
-    let mut before = ReducedModel::new(mech.clone(), Box::new(b));
+    let mut before = ReducedModel::new(mech.clone(), Box::new(b)).unwrap();
     let mut after = loaded.into_model(mech.clone()).unwrap();
     let z_ref = after.basis().z_reference();
     assert_eq!(z_ref, before.basis().z_reference());
