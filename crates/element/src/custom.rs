@@ -7,6 +7,7 @@ use crate::inertia::MAX_MODES;
 use crate::kernels::{
     jacobian, second_directional, third_directional, weighted_hessian, DeformationKernel,
 };
+use crate::kinetic::ErasedInertia;
 use std::marker::PhantomData;
 use std::sync::Arc;
 
@@ -113,29 +114,51 @@ where
     }
 }
 
-/// A custom element's kernel and its constant mass matrix (row-major n_x × n_x).
+/// The inertia of a custom element.
+#[derive(Clone)]
+pub(crate) enum CustomInertia {
+    /// A constant mass matrix (row-major n_x × n_x), T = ½ ẋᵀMẋ.
+    Constant(Vec<f64>),
+    /// A configuration-dependent mass from a kinetic-energy kernel.
+    Energy(Arc<dyn ErasedInertia>),
+}
+
+/// A custom element's kernel and its inertia, if any.
 #[derive(Clone)]
 pub(crate) struct CustomKind {
     pub kernel: Arc<dyn ErasedKernel>,
-    pub mass: Option<Vec<f64>>,
+    pub inertia: Option<CustomInertia>,
 }
 
 impl std::fmt::Debug for CustomKind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "Custom({}, n_x = {}, n_ε = {}, mass: {})",
+            "Custom({}, n_x = {}, n_ε = {}, inertia: {})",
             self.kernel.type_name(),
             self.kernel.n_x(),
             self.kernel.n_eps(),
-            self.mass.is_some()
+            match self.inertia {
+                None => "none",
+                Some(CustomInertia::Constant(_)) => "constant mass matrix",
+                Some(CustomInertia::Energy(_)) => "kinetic-energy kernel",
+            }
         )
     }
 }
 
 impl PartialEq for CustomKind {
-    /// The same kernel object (kernels are not comparable) and the same mass.
+    /// The same kernel objects (kernels are not comparable) and the same
+    /// constant mass.
     fn eq(&self, o: &Self) -> bool {
-        Arc::ptr_eq(&self.kernel, &o.kernel) && self.mass == o.mass
+        Arc::ptr_eq(&self.kernel, &o.kernel)
+            && match (&self.inertia, &o.inertia) {
+                (None, None) => true,
+                (Some(CustomInertia::Constant(a)), Some(CustomInertia::Constant(b))) => a == b,
+                (Some(CustomInertia::Energy(a)), Some(CustomInertia::Energy(b))) => {
+                    Arc::ptr_eq(a, b)
+                }
+                _ => false,
+            }
     }
 }

@@ -7,13 +7,14 @@ use crate::beam_matrices::{
     equivalent_stiffness, planar_a_diag, planar_beam_m_bar, planar_beam_s_bar, spatial_a_diag,
     spatial_beam_m_bar, spatial_beam_s_bar,
 };
-use crate::custom::{CustomKind, Erased, MAX_ELEMENT_COORDS};
+use crate::custom::{CustomInertia, CustomKind, Erased, MAX_ELEMENT_COORDS};
 use crate::inertia::{psd_factor, PlanarInertia, SpatialInertia, VelocityTransform, MAX_MODES};
 use crate::kernels::{
     jacobian, second_directional, third_directional, weighted_hessian, DeformationKernel,
     NormalizationKernel, PlanarBeamKernel, PlanarHingeKernel, SpatialHingeKernel, TrussKernel,
     TwoNodeSpatial,
 };
+use crate::kinetic::{ErasedEnergy, KineticEnergyKernel};
 use crate::section::{positive, Material, SectionShape};
 use crate::superelement::LinearSuperelement;
 use crate::ElementError;
@@ -541,7 +542,9 @@ impl Element {
     /// * `type_name`: a short name for messages and summaries.
     ///
     /// The element is massless unless [`with_mass_matrix`](Self::with_mass_matrix)
-    /// gives it a constant mass matrix. Errors: sizes that disagree, a
+    /// gives it a constant mass matrix or
+    /// [`with_kinetic_energy`](Self::with_kinetic_energy) a configuration-dependent
+    /// one. Errors: sizes that disagree, a
     /// non-finite stiffness, and `NX` or `NE` above [`MAX_ELEMENT_COORDS`]
     /// ([`ElementError::TooLarge`]).
     ///
@@ -620,7 +623,7 @@ impl Element {
                     name: type_name,
                     _sizes: std::marker::PhantomData,
                 }),
-                mass: None,
+                inertia: None,
             }),
             slots.to_vec(),
             names(deformation_names),
@@ -633,8 +636,8 @@ impl Element {
     /// matrix M (n_x × n_x, symmetric positive semi-definite) over its local
     /// coordinates: kinetic energy T = ½ ẋᵀMẋ, inertia force M ẍ (h = 0),
     /// gravity force M ẋ_g with ẋ_g = g on every position slot. This is the
-    /// inertia of trusses and point masses; for co-rotational inertia (beams,
-    /// rigid bodies) add built-in mass elements on the element's nodes.
+    /// inertia of trusses and point masses; for a mass that depends on the
+    /// configuration see [`with_kinetic_energy`](Self::with_kinetic_energy).
     pub fn with_mass_matrix(mut self, m: DMatrix<f64>) -> Result<Self, ElementError> {
         let n = self.n_x();
         let bad = |why: String| ElementError::InvalidProperty {
@@ -658,7 +661,78 @@ impl Element {
         if asym > 1e-12 * m.amax() || psd_factor(&rm, n).is_none() {
             return Err(bad("must be symmetric positive semi-definite".into()));
         }
-        c.mass = rm.iter().any(|v| *v != 0.0).then_some(rm);
+        c.inertia = rm
+            .iter()
+            .any(|v| *v != 0.0)
+            .then_some(CustomInertia::Constant(rm));
+        Ok(self)
+    }
+
+    /// Gives a custom element ([`custom`](Self::custom)) the inertia of a
+    /// kinetic energy T(x, ẋ) = ½ ẋᵀM(x)ẋ written once over a generic scalar
+    /// ([`KineticEnergyKernel`]): a mass matrix that depends on the
+    /// configuration, such as a rigid body carried by a node's frame or a
+    /// co-rotational element. The mass matrix M = ∂²T/∂ẋ², the inertia force
+    /// F = d/dt(∂T/∂ẋ) − ∂T/∂x of Lagrange's equations, their derivatives
+    /// and the gravity force M ẋ_g (ẋ_g = g on every position slot) follow
+    /// exactly by dual numbers. `NX` must be the element's n_x.
+    ///
+    /// ```
+    /// use flexmb_dual::Real;
+    /// use flexmb_element::{DeformationKernel, Element, KineticEnergyKernel, Slot};
+    /// use nalgebra::DMatrix;
+    /// /// No deformation: a body carried by one planar node.
+    /// struct Carried;
+    /// impl DeformationKernel<3, 0> for Carried {
+    ///     fn eval<T: Real>(&self, _x: &[T; 3]) -> [T; 0] { [] }
+    /// }
+    /// /// A point mass 2 kg at 1 m along the node's x axis.
+    /// struct Bob;
+    /// impl KineticEnergyKernel<3> for Bob {
+    ///     fn kinetic_energy<T: Real>(&self, x: &[T; 3], v: &[T; 3]) -> T {
+    ///         let vx = v[0] - v[2] * x[2].sin();
+    ///         let vy = v[1] + v[2] * x[2].cos();
+    ///         (vx * vx + vy * vy) * 1.0
+    ///     }
+    /// }
+    /// let e = Element::custom("bob", Carried, &[Slot::Position2, Slot::Angle], &[],
+    ///                         DMatrix::zeros(0, 0)).unwrap()
+    ///     .with_kinetic_energy(Bob).unwrap();
+    /// // turned by 90°: the bob's x velocity is −φ̇, so M[0][2] = −2
+    /// let mut m = [0.0; 9];
+    /// e.mass_matrix(&[0.0, 0.0, std::f64::consts::FRAC_PI_2], &mut m);
+    /// assert!((m[2] + 2.0).abs() < 1e-12 && (m[8] - 2.0).abs() < 1e-12);
+    /// ```
+    pub fn with_kinetic_energy<K, const NX: usize>(
+        mut self,
+        kernel: K,
+    ) -> Result<Self, ElementError>
+    where
+        K: KineticEnergyKernel<NX> + Send + Sync + 'static,
+    {
+        let n = self.n_x();
+        let name = self.type_name().to_string();
+        let Kind::Custom(c) = &mut self.kind else {
+            return Err(ElementError::InvalidProperty {
+                what: "kinetic-energy kernel".into(),
+                value: NX as f64,
+                why: format!("only a custom element takes a kinetic-energy kernel, not a {name}"),
+            });
+        };
+        if NX != n {
+            return Err(ElementError::InvalidProperty {
+                what: format!("custom element '{name}' kinetic-energy kernel"),
+                value: NX as f64,
+                why: format!("the kernel takes NX = {NX} coordinates, the element has n_x = {n}"),
+            });
+        }
+        c.inertia = Some(CustomInertia::Energy(std::sync::Arc::new(ErasedEnergy::<
+            K,
+            NX,
+        > {
+            kernel,
+            _size: std::marker::PhantomData,
+        })));
         Ok(self)
     }
 
@@ -762,7 +836,7 @@ impl Element {
             Kind::PlanarMass { .. } | Kind::PointMass { .. } | Kind::RigidBody(_) => true,
             Kind::TwoNode { inertia, .. } => inertia.is_some(),
             Kind::PlanarHinge | Kind::Hinge { .. } | Kind::Normalization => false,
-            Kind::Custom(c) => c.mass.is_some(),
+            Kind::Custom(c) => c.inertia.is_some(),
         }
     }
 
@@ -1143,7 +1217,11 @@ impl Element {
                     out[a * n + a] = *m;
                 }
             }
-            Kind::Custom(CustomKind { mass: Some(m), .. }) => out[..n * n].copy_from_slice(m),
+            Kind::Custom(c) => match &c.inertia {
+                Some(CustomInertia::Constant(m)) => out[..n * n].copy_from_slice(m),
+                Some(CustomInertia::Energy(k)) => k.mass(x, out),
+                None => {}
+            },
             _ => {}
         }
     }
@@ -1196,8 +1274,18 @@ impl Element {
                 out[..n * n].copy_from_slice(&u);
                 Some(n)
             }
-            Kind::Custom(CustomKind { mass: Some(m), .. }) => {
-                let u = psd_factor(m, n)?;
+            Kind::Custom(CustomKind {
+                inertia: Some(inertia),
+                ..
+            }) => {
+                let u = match inertia {
+                    CustomInertia::Constant(m) => psd_factor(m, n)?,
+                    CustomInertia::Energy(k) => {
+                        let mut m = [0.0; MAX_ELEMENT_COORDS * MAX_ELEMENT_COORDS];
+                        k.mass(x, &mut m);
+                        psd_factor(&m[..n * n], n)?
+                    }
+                };
                 out[..n * n].copy_from_slice(&u);
                 Some(n)
             }
@@ -1225,11 +1313,18 @@ impl Element {
                     out[r] = (0..n).map(|c| m[r * n + c] * xdd[c]).sum();
                 }
             }
-            Kind::Custom(CustomKind { mass: Some(m), .. }) => {
+            Kind::Custom(CustomKind {
+                inertia: Some(CustomInertia::Constant(m)),
+                ..
+            }) => {
                 for r in 0..n {
                     out[r] = (0..n).map(|c| m[r * n + c] * xdd[c]).sum();
                 }
             }
+            Kind::Custom(CustomKind {
+                inertia: Some(CustomInertia::Energy(k)),
+                ..
+            }) => k.force(x, xd, xdd, out),
             _ => out[..n].fill(0.0),
         }
     }
@@ -1259,6 +1354,10 @@ impl Element {
                 inertia: Some(i), ..
             } => force_derivatives::<_, 14>(i, n, x, xd, xdd, dfdx, dfdxd),
             Kind::RigidBody(i) => force_derivatives::<_, 7>(i, n, x, xd, xdd, dfdx, dfdxd),
+            Kind::Custom(CustomKind {
+                inertia: Some(CustomInertia::Energy(k)),
+                ..
+            }) => k.force_derivatives(x, xd, xdd, dfdx, dfdxd),
             _ => {
                 dfdx[..n * n].fill(0.0);
                 dfdxd[..n * n].fill(0.0);
@@ -1301,7 +1400,14 @@ impl Element {
                 }
                 e
             }
-            Kind::Custom(CustomKind { mass: Some(m), .. }) => {
+            Kind::Custom(CustomKind {
+                inertia: Some(CustomInertia::Energy(k)),
+                ..
+            }) => k.kinetic_energy(x, xd),
+            Kind::Custom(CustomKind {
+                inertia: Some(CustomInertia::Constant(m)),
+                ..
+            }) => {
                 let n = self.n_x();
                 let mut e = 0.0;
                 for r in 0..n {
@@ -1346,19 +1452,18 @@ impl Element {
                 let zero = [0.0; 6];
                 self.inertia_force(x, &zero, &xg, out);
             }
-            Kind::Custom(CustomKind { mass: Some(_), .. }) => {
-                let mut xg = [0.0; MAX_ELEMENT_COORDS];
-                let mut i = 0;
-                for s in &self.slots {
-                    match s {
-                        Slot::Position2 => xg[i..i + 2].copy_from_slice(&g[..2]),
-                        Slot::Position3 => xg[i..i + 3].copy_from_slice(g),
-                        _ => {}
+            Kind::Custom(CustomKind {
+                inertia: Some(inertia),
+                ..
+            }) => {
+                let xg = self.gravity_velocity(g);
+                match inertia {
+                    CustomInertia::Energy(k) => k.gravity(x, &xg[..n], out),
+                    CustomInertia::Constant(_) => {
+                        let zero = [0.0; MAX_ELEMENT_COORDS];
+                        self.inertia_force(x, &zero[..n], &xg[..n], out);
                     }
-                    i += s.len();
                 }
-                let zero = [0.0; MAX_ELEMENT_COORDS];
-                self.inertia_force(x, &zero[..n], &xg[..n], out);
             }
             _ => out[..n].fill(0.0),
         }
@@ -1391,7 +1496,28 @@ impl Element {
                 inertia: Some(i), ..
             } => go!(i, 14),
             Kind::RigidBody(i) => go!(i, 7),
+            Kind::Custom(CustomKind {
+                inertia: Some(CustomInertia::Energy(k)),
+                ..
+            }) => k.gravity_derivative(x, &self.gravity_velocity(g)[..n], out),
             _ => {}
         }
+    }
+
+    /// ẋ_g: the uniform acceleration `g` on every position slot, zero on
+    /// the other coordinates (the gravity force of a custom element is
+    /// M(x) ẋ_g).
+    fn gravity_velocity(&self, g: &[f64; 3]) -> [f64; MAX_ELEMENT_COORDS] {
+        let mut xg = [0.0; MAX_ELEMENT_COORDS];
+        let mut i = 0;
+        for s in &self.slots {
+            match s {
+                Slot::Position2 => xg[i..i + 2].copy_from_slice(&g[..2]),
+                Slot::Position3 => xg[i..i + 3].copy_from_slice(g),
+                _ => {}
+            }
+            i += s.len();
+        }
+        xg
     }
 }

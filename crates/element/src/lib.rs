@@ -46,6 +46,7 @@ mod custom;
 mod element;
 mod inertia;
 mod kernels;
+mod kinetic;
 mod section;
 mod superelement;
 
@@ -57,6 +58,7 @@ pub use custom::MAX_ELEMENT_COORDS;
 pub use element::{frame_from_axis, BeamOptions, Element, Slot, FLIP_ANGLE};
 pub use inertia::{VelocityTransform, MAX_MODES};
 pub use kernels::DeformationKernel;
+pub use kinetic::KineticEnergyKernel;
 pub use section::{rectangle_torsion_constant, Material, SectionProperties, SectionShape};
 pub use superelement::{LinearSuperelement, ModeKind, Provenance, Side};
 
