@@ -304,6 +304,7 @@ pub(crate) enum Method {
     /// [`DENSE_MAX_DEPENDENT`] dependent coordinates).
     Sparse,
     /// `Sparse` without the local bounds: the blocks alone (tests).
+    #[cfg_attr(not(test), allow(dead_code))]
     Blocks,
 }
 
@@ -1028,7 +1029,7 @@ fn rigid_motions(p: &Problem) -> (Vec<f64>, usize) {
     // column-major while built
     let nf = p.free.len();
     let mut cols = vec![vec![0.0; nf]; nm];
-    let mut set = |col: &mut Vec<f64>, i: usize, v: f64| {
+    let set = |col: &mut Vec<f64>, i: usize, v: f64| {
         if p.free_pos[i] != usize::MAX {
             col[p.free_pos[i]] = v;
         }
