@@ -1,7 +1,9 @@
 //! Assembly of a clamped spatial beam chain (the chain helper, `n` beams,
-//! 7(n+1) nodal coordinates, 6n DOFs): parsing, elements, the sparse choice of
-//! DOFs. This is all `flexmb info` does besides printing. Targets (issue 14):
-//! ≤ 2 s at n = 1000, ≤ 30 s at n = 20000.
+//! 7(n+1) nodal coordinates, 6n DOFs) and of the tumbling beam of
+//! `fixtures/scenes/tumbling_beam.ron` split into `n` beams (no support,
+//! rigid elongation and torsion, 4n + 6 DOFs): parsing, elements, the sparse
+//! choice of DOFs. This is all `flexmb info` does besides printing. Targets
+//! (issue 14): ≤ 2 s at n = 1000, ≤ 30 s at n = 20000.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexmb_model::Scene;
@@ -37,6 +39,20 @@ fn bench(c: &mut Criterion) {
                     .build(None)
                     .unwrap();
                 assert_eq!(m.n_dof(), 6 * n);
+                m
+            })
+        });
+    }
+    let tumbling = include_str!("../../../fixtures/scenes/tumbling_beam.ron");
+    for n in [1000, 20000] {
+        let text = tumbling.replace("n: 2)", &format!("n: {n})"));
+        g.bench_function(format!("free, n = {n}"), |b| {
+            b.iter(|| {
+                let m = Scene::from_ron_str(black_box(&text))
+                    .unwrap()
+                    .build(None)
+                    .unwrap();
+                assert_eq!(m.n_dof(), 4 * n + 6);
                 m
             })
         });

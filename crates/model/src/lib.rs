@@ -31,6 +31,7 @@ mod build;
 mod chart;
 mod error;
 mod loads;
+mod local_span;
 mod mechanism;
 mod naming;
 mod outputs;

@@ -5,6 +5,7 @@
 //! configuration, which also names redundant equations or undetermined
 //! coordinates.
 
+use crate::local_span::{LocalSpan, Verdict};
 use crate::mechanism::*;
 use crate::scene::*;
 use crate::ModelError;
@@ -297,10 +298,14 @@ pub(crate) enum Method {
     Auto,
     /// One SVD of the whole constraint Jacobian (the original method).
     Dense,
-    /// Connected blocks, eliminated as they become determined (forced: also
+    /// Local bounds ([`crate::local_span`]), and where they do not decide,
+    /// connected blocks, eliminated as they become determined (forced: also
     /// the final regularity check, which `Auto` does with an SVD up to
     /// [`DENSE_MAX_DEPENDENT`] dependent coordinates).
     Sparse,
+    /// `Sparse` without the local bounds: the blocks alone (tests).
+    #[cfg_attr(not(test), allow(dead_code))]
+    Blocks,
 }
 
 /// Up to this many free coordinates the dense SVD is used: it takes
@@ -313,6 +318,13 @@ const DENSE_MAX_DEPENDENT: usize = 1000;
 thread_local! {
     /// The method `assign` uses (tests compare the two).
     pub(crate) static METHOD: std::cell::Cell<Method> = const { std::cell::Cell::new(Method::Auto) };
+    /// How often the local bounds did not decide and the blocks were used
+    /// (tests check that a chain needs them nowhere).
+    pub(crate) static BLOCK_FALLBACKS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+fn count_fallback() {
+    BLOCK_FALLBACKS.with(|c| c.set(c.get() + 1));
 }
 
 /// What the choice of DOFs works on: the roles given by the scene and the
@@ -948,7 +960,15 @@ fn choose_dense(scene: &Scene, p: &Problem) -> Result<Vec<Coordinate>, ModelErro
 
 /// The choice of DOFs with the sparse method; errors are worded by the dense
 /// method when it fits in memory (so they are the same as for a small model).
-fn choose_sparse(scene: &Scene, p: &Problem) -> Result<Vec<Coordinate>, ModelError> {
+/// The local bounds are tried first (`Method::Sparse`): when they decide
+/// every step and find no error, their choice is the blocks' choice.
+fn choose_sparse(scene: &Scene, p: &Problem, m: Method) -> Result<Vec<Coordinate>, ModelError> {
+    if m == Method::Sparse {
+        if let Some(chosen) = choose_local(scene, p) {
+            return Ok(chosen);
+        }
+        count_fallback();
+    }
     let mut sparse = match Sparse::new(p) {
         Ok(s) => s,
         Err(SparseFailure::Redundant(j)) => {
@@ -986,6 +1006,159 @@ fn choose_sparse(scene: &Scene, p: &Problem) -> Result<Vec<Coordinate>, ModelErr
         });
     }
     Ok(chosen)
+}
+
+/// The rigid motions of the whole mechanism at its reference configuration
+/// on the free coordinates (n_free × q, row-major, orthonormal columns):
+/// translations and rotations about the centroid of the nodes (ẋ = ω × (x −
+/// c), λ̇ = ½ Λ(λ)ᵀ ω from ω = 2Λλ̇ (2.13); planar φ̇ = ω). Deformations are
+/// invariant under them, so they are orthogonal to every deformation row
+/// that has no fixed coordinate; [`LocalSpan::push`] removes the rest.
+fn rigid_motions(p: &Problem) -> (Vec<f64>, usize) {
+    let mech = p.mech;
+    let spatial = mech.dimension == Dimension::Spatial;
+    let dim = if spatial { 3 } else { 2 };
+    let nm = if spatial { 6 } else { 3 };
+    let nn = mech.nodes.len().max(1) as f64;
+    let mut c = [0.0; 3];
+    for n in &mech.nodes {
+        for (k, i) in n.position.iter().enumerate().take(dim) {
+            c[k] += mech.x0[*i] / nn;
+        }
+    }
+    // column-major while built
+    let nf = p.free.len();
+    let mut cols = vec![vec![0.0; nf]; nm];
+    let set = |col: &mut Vec<f64>, i: usize, v: f64| {
+        if p.free_pos[i] != usize::MAX {
+            col[p.free_pos[i]] = v;
+        }
+    };
+    for n in &mech.nodes {
+        let mut r = [0.0; 3];
+        for (k, i) in n.position.iter().enumerate().take(dim) {
+            r[k] = mech.x0[*i] - c[k];
+        }
+        for k in 0..dim {
+            set(&mut cols[k], n.position[k], 1.0);
+        }
+        if spatial {
+            for w in 0..3 {
+                // e_w × r
+                let mut e = [0.0; 3];
+                e[w] = 1.0;
+                let v = [
+                    e[1] * r[2] - e[2] * r[1],
+                    e[2] * r[0] - e[0] * r[2],
+                    e[0] * r[1] - e[1] * r[0],
+                ];
+                for k in 0..3 {
+                    set(&mut cols[3 + w], n.position[k], v[k]);
+                }
+                if let Some(o) = n.orientation.as_ref().filter(|o| o.len() == 4) {
+                    let l = [mech.x0[o[0]], mech.x0[o[1]], mech.x0[o[2]], mech.x0[o[3]]];
+                    let lam = flexmb_rotation::generic::lambda_mat(&l);
+                    for k in 0..4 {
+                        set(&mut cols[3 + w], o[k], 0.5 * lam[w][k]);
+                    }
+                }
+            }
+        } else {
+            set(&mut cols[2], n.position[0], -r[1]);
+            set(&mut cols[2], n.position[1], r[0]);
+            if let Some(o) = n.orientation.as_ref().filter(|o| o.len() == 1) {
+                set(&mut cols[2], o[0], 1.0);
+            }
+        }
+    }
+    let mut kept: Vec<Vec<f64>> = vec![];
+    for mut v in cols {
+        let n0 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        for _ in 0..2 {
+            for b in &kept {
+                let d: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
+                v.iter_mut().zip(b).for_each(|(x, y)| *x -= d * y);
+            }
+        }
+        let nv = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if nv > 1e-8 * n0.max(1e-300) {
+            kept.push(v.into_iter().map(|x| x / nv).collect());
+        }
+    }
+    let q = kept.len();
+    let mut z = vec![0.0; nf * q];
+    for (k, col) in kept.iter().enumerate() {
+        for (i, v) in col.iter().enumerate() {
+            z[i * q + k] = *v;
+        }
+    }
+    (z, q)
+}
+
+/// The greedy choice on local bounds: every equation independent and every
+/// candidate decided, or `None` (the blocks then choose, and word errors).
+fn choose_local(scene: &Scene, p: &Problem) -> Option<Vec<Coordinate>> {
+    let (z, q) = rigid_motions(p);
+    let mut span = LocalSpan::new(p.free.len(), z, q);
+    for j in &p.crow {
+        let a = p.equation(*j);
+        // the blocks' test: redundant below 1e-7
+        if span.decide(&a, 1e-7, 0.0) != Verdict::Above {
+            return None;
+        }
+        span.push(a);
+    }
+    let mut local = Local {
+        p,
+        span,
+        undecided: false,
+    };
+    let d = p.free.len() - p.crow.len();
+    let chosen = greedy(scene, p, d, &mut local).ok()?;
+    (!local.undecided && chosen.len() == d).then_some(chosen)
+}
+
+/// The oracle of [`choose_local`]; after a step it cannot decide it
+/// rejects everything, and its result is discarded.
+struct Local<'p, 'a> {
+    p: &'p Problem<'a>,
+    span: LocalSpan,
+    undecided: bool,
+}
+
+impl Oracle for Local<'_, '_> {
+    fn accept(&mut self, c: Coordinate) -> bool {
+        if self.undecided {
+            return false;
+        }
+        let a = self.p.candidate(c);
+        // `accepted`: above 1e-6 always, at most 1e-9 never, between by n0
+        match self.span.decide(&a, 1e-6, 1e-9) {
+            Verdict::Above => {
+                self.span.push(a);
+                true
+            }
+            Verdict::Below => false,
+            Verdict::Undecided => {
+                self.undecided = true;
+                false
+            }
+        }
+    }
+}
+
+/// The final regularity check on local bounds: true when every row is shown
+/// to be independent of the earlier ones by more than `tol`.
+fn regular_by_local_bounds(rows: &[Vec<(usize, f64)>], n: usize, tol: f64) -> bool {
+    let mut span = LocalSpan::new(n, vec![], 0);
+    for r in rows {
+        if span.decide(r, tol, 0.0) != Verdict::Above {
+            count_fallback();
+            return false;
+        }
+        span.push(r.clone());
+    }
+    true
 }
 
 pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelError> {
@@ -1097,7 +1270,7 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
         m => m,
     };
     let chosen = match method {
-        Method::Sparse => choose_sparse(scene, &problem)?,
+        Method::Sparse | Method::Blocks => choose_sparse(scene, &problem, method)?,
         _ => choose_dense(scene, &problem)?,
     };
     let rows = problem.rows;
@@ -1162,8 +1335,8 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
     for (k, i) in mech.dependent.iter().enumerate() {
         dep_pos[*i] = k;
     }
-    let forced = METHOD.with(|m| m.get()) == Method::Sparse;
-    if method == Method::Sparse && (nd > DENSE_MAX_DEPENDENT || forced) {
+    let forced = matches!(METHOD.with(|m| m.get()), Method::Sparse | Method::Blocks);
+    if method != Method::Dense && (nd > DENSE_MAX_DEPENDENT || forced) {
         // in the greedy's order (equations, then the chosen deformations), in
         // which the blocks stay small
         let mut order: Vec<usize> = mech
@@ -1188,11 +1361,15 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
             .collect();
         let norm = |r: &[(usize, f64)]| r.iter().map(|(_, v)| v * v).sum::<f64>().sqrt();
         let max = dep_rows.iter().map(|r| norm(r)).fold(0.0f64, f64::max);
+        let tol = RANK_TOL * max.max(1e-300);
+        if method == Method::Sparse && regular_by_local_bounds(&dep_rows, nd, tol) {
+            return Ok(());
+        }
         let mut blocks = Blocks::new(nd);
         let mut deficient = 0;
         for r in &dep_rows {
             let nr = blocks.residual(r);
-            if nr > RANK_TOL * max.max(1e-300) {
+            if nr > tol {
                 blocks.commit(nr);
             } else {
                 deficient += 1;
@@ -1267,7 +1444,16 @@ mod tests {
         let d = build_with(scene, dir, Method::Dense);
         let s = build_with(scene, dir, Method::Sparse);
         assert_eq!(d, s, "{what}: the sparse choice differs from the dense one");
+        let b = build_with(scene, dir, Method::Blocks);
+        assert_eq!(
+            d, b,
+            "{what}: the blocks' choice differs from the dense one"
+        );
         d.is_ok()
+    }
+
+    fn fallbacks() -> usize {
+        BLOCK_FALLBACKS.with(|c| c.get())
     }
 
     fn root() -> PathBuf {
@@ -1475,6 +1661,78 @@ mod tests {
             assert!(!same(&scene, None, to), "{to}");
             let e = build_with(&scene, None, Method::Sparse).unwrap_err();
             assert!(e.contains(named), "{e}");
+        }
+    }
+
+    /// Chains without supports (the tumbling beam, spatial and planar, with
+    /// either choice of DOFs): the same choice as the dense SVD, decided by
+    /// the local bounds alone (no fallback to the blocks, which grow with
+    /// the cube of n), except where a DOF candidate is determined only
+    /// through the whole chain (nodal coordinates as DOFs with rigid
+    /// elongations: the end node's x follows from all the elongations).
+    #[test]
+    fn free_chains_are_chosen_locally_as_the_dense_svd_chooses() {
+        let tumbling =
+            std::fs::read_to_string(root().join("fixtures/scenes/tumbling_beam.ron")).unwrap();
+        let planar = r#"(
+    dimension: Planar,
+    materials: { "al": (e: 7.0e10, rho: 2700.0) },
+    sections: { "bar": Rectangle(by: 0.01, bz: 0.02) },
+    nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [1.0, 0.5]) ],
+    elements: [ (id: "arm", type: Beam((nodes: ("A", "B"), material: "al", section: "bar", n: 2))) ],
+    rigid: [ Def("arm", "elongation") ],
+)"#;
+        let rigid = "rigid: [ Def(\"beam\", \"elongation\"), Def(\"beam\", \"torsion\") ],";
+        let nodal = |t: &str| t.replace(")),\n    ],", ")),\n    ],\n    dofs: NodalCoordinates,");
+        let mut cases = vec![];
+        for n in [3, 12, 45] {
+            let t = tumbling.replace("n: 2)", &format!("n: {n})"));
+            cases.push((t.clone(), true));
+            cases.push((t.replace(rigid, ""), true));
+            cases.push((nodal(&t.replace(rigid, "")), true));
+            cases.push((nodal(&t), n < 20));
+            let pl = planar.replace("n: 2)", &format!("n: {n})"));
+            cases.push((pl.clone(), true));
+            cases.push((
+                pl.replace(
+                    "rigid: [ Def(\"arm\", \"elongation\") ],",
+                    "dofs: NodalCoordinates,",
+                ),
+                true,
+            ));
+        }
+        for (text, local) in &cases {
+            let scene = Scene::from_ron_str(text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            let before = fallbacks();
+            assert!(same(&scene, None, text), "{text}");
+            assert_eq!(fallbacks() == before, *local, "local bounds:\n{text}");
+        }
+        assert_eq!(
+            cases
+                .iter()
+                .filter(|c| c.0.contains("NodalCoordinates"))
+                .count(),
+            9
+        );
+    }
+
+    /// `flexmb info`'s work on large free chains (cargo test --release -- --ignored).
+    #[test]
+    #[ignore]
+    fn timing_free_chain() {
+        let text =
+            std::fs::read_to_string(root().join("fixtures/scenes/tumbling_beam.ron")).unwrap();
+        for n in [400, 1000, 5000, 20000] {
+            let scene = Scene::from_ron_str(&text.replace("n: 2)", &format!("n: {n})"))).unwrap();
+            let before = fallbacks();
+            let t = std::time::Instant::now();
+            let m = scene.build(None).unwrap();
+            eprintln!(
+                "n = {n}: {:?}, {} DOFs, fallbacks {}",
+                t.elapsed(),
+                m.n_dof(),
+                fallbacks() - before
+            );
         }
     }
 
