@@ -11,7 +11,7 @@ use crate::models::{
 use crate::progress::Progress;
 use crate::regress::Recomputed;
 use crate::report::{
-    pct, rms_and_max, sig, speed_vs_error_plot, speed_vs_error_table, ModelRow, Table,
+    pct, rms_and_max, sig, speed_vs_error_plot, speed_vs_error_table, Figures, ModelRow, Table,
 };
 use flexmb_dynamics::{Integrator, SimulationOptions};
 use flexmb_linearize::{sweep, SweepOptions, SweepParameter};
@@ -268,17 +268,21 @@ fn write(
     let base = run("Unreduced").expect("unreduced guidance run");
     let xb: Vec<f64> = base.response.position.iter().map(|p| p[0]).collect();
     let t = &base.response.t;
-    Plot::new(
-        "Fig. 5.3a: x-displacement of the intermediate body",
-        "t (s)",
-        "x (mm)",
-    )
-    .series(Series::line(
-        "Unreduced",
-        t,
-        &xb.iter().map(|v| 1e3 * v).collect::<Vec<_>>(),
-    ))
-    .save(&out.join("fig5_3a_x_response.svg"))?;
+    let mut figs = Figures::default();
+    figs.save(
+        &Plot::new(
+            "Fig. 5.3a: x-displacement of the intermediate body",
+            "t (s)",
+            "x (mm)",
+        )
+        .series(Series::line(
+            "Unreduced",
+            t,
+            &xb.iter().map(|v| 1e3 * v).collect::<Vec<_>>(),
+        )),
+        out,
+        "fig5_3a_x_response",
+    )?;
     let mut p = Plot::new(
         "Fig. 5.3b: error of the x-response relative to 0.0833 m",
         "t (s)",
@@ -300,7 +304,7 @@ fn write(
             cols.push(r.response.position.iter().map(|a| a[0]).collect());
         }
     }
-    p.save(&out.join("fig5_3b_x_error.svg"))?;
+    figs.save(&p, out, "fig5_3b_x_error")?;
     let rows: Vec<Vec<f64>> = (0..t.len())
         .map(|i| cols.iter().map(|c| c[i]).collect())
         .collect();
@@ -314,12 +318,13 @@ fn write(
     for (k, s) in g.svd.iter().enumerate() {
         let n = s.relative.len().min(15);
         let i: Vec<f64> = (1..=n).map(|v| v as f64).collect();
-        Plot::new(
+        let p = Plot::new(
             &format!("Fig. 5.4{}: singular values, a = {k}", ['a', 'b'][k]),
             "singular vector",
-            "singular value (% of the sum)",
+            "singular value relative to the sum",
         )
         .log_y()
+        .y_unit("%")
         .series(Series::points(
             "singular values",
             &i,
@@ -328,8 +333,16 @@ fn write(
                 .map(|v| 100.0 * v)
                 .collect::<Vec<_>>(),
         ))
-        .series(Series::dashed("1 %", &[1.0, n as f64], &[1.0, 1.0]))
-        .save(&out.join(format!("fig5_4{}_singular_values_a{k}.svg", ['a', 'b'][k])))?;
+        .series(Series::dashed(
+            "1 % (kept above)",
+            &[1.0, n as f64],
+            &[1.0, 1.0],
+        ));
+        figs.save(
+            &p,
+            out,
+            &format!("fig5_4{}_singular_values_a{k}", ['a', 'b'][k]),
+        )?;
     }
     // Fig. 5.5: ω2, ω3 over the stroke
     for k in [1usize, 2] {
@@ -351,7 +364,7 @@ fn write(
                 Series::dashed(n, &x, &y)
             });
         }
-        p.save(&out.join(format!("fig5_5_omega{}.svg", k + 1)))?;
+        figs.save(&p, out, &format!("fig5_5_omega{}", k + 1))?;
     }
     for c in curves {
         StoredCurve::from_points(&c.0, &c.1, 0, 3)
@@ -372,7 +385,7 @@ fn write(
         let y: Vec<f64> = r.response.position.iter().map(|p| p[1] + at[1]).collect();
         p.push(Series::line(&r.model.name, &x, &y));
     }
-    p.save(&out.join("fig5_7a_tip_path.svg"))?;
+    figs.save(&p, out, "fig5_7a_tip_path")?;
     let stride = 7;
     let idx: Vec<usize> = (0..mu.response.t.len()).step_by(stride).collect();
     let mut freq_t: Vec<Vec<Vec<f64>>> = vec![];
@@ -401,7 +414,7 @@ fn write(
             });
         }
     }
-    p.save(&out.join("fig5_7b_omega_along_motion.svg"))?;
+    figs.save(&p, out, "fig5_7b_omega_along_motion")?;
     // rows
     let mut rows_out = vec![];
     for r in runs {
@@ -465,10 +478,13 @@ fn write(
         .filter(|r| r.name.starts_with("Manipulator"))
         .cloned()
         .collect();
-    speed_vs_error_plot(
-        "Chapter 5 guidance: speed against error",
-        &guidance_rows[1..],
-        &out.join("speed_vs_error_guidance.svg"),
+    figs.save(
+        &speed_vs_error_plot(
+            "Chapter 5 guidance: speed against error",
+            &guidance_rows[1..],
+        ),
+        out,
+        "speed_vs_error_guidance",
     )?;
     // report
     let mut s = String::new();
@@ -527,8 +543,13 @@ fn write(
         "### Guidance\n\n{}",
         speed_vs_error_table(&guidance_rows)
     );
+    let _ = writeln!(s, "{}", figs.markdown(|f| f.starts_with("speed_vs_error")));
     let _ = writeln!(s, "### Manipulator\n\n{}", speed_vs_error_table(&man_rows));
-    let _ = writeln!(s, "Figures: `fig5_3a_x_response.svg`, `fig5_3b_x_error.svg`, `fig5_4a/b_singular_values_a0/a1.svg`, `fig5_5_omega2/3.svg`, `fig5_7a_tip_path.svg`, `fig5_7b_omega_along_motion.svg`, `speed_vs_error_guidance.svg`.");
+    let _ = writeln!(
+        s,
+        "## Figures\n\nEach figure is written as SVG and PNG side by side.\n"
+    );
+    let _ = writeln!(s, "{}", figs.markdown(|f| !f.starts_with("speed_vs_error")));
     std::fs::write(out.join("report.md"), s)?;
     Ok(rows_out)
 }

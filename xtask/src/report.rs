@@ -214,18 +214,19 @@ pub fn speed_vs_error_table(rows: &[ModelRow]) -> String {
 }
 
 /// The speed-against-error plot: wall time against the largest error over
-/// the retained eigenfrequencies and the time responses (log scales as
-/// log10 on both axes, one point per model).
-pub fn speed_vs_error_plot(
-    title: &str,
-    rows: &[ModelRow],
-    path: &std::path::Path,
-) -> std::io::Result<()> {
+/// the retained eigenfrequencies and the time responses, on log–log axes
+/// (ticks in s and %), one labelled point per model.
+pub fn speed_vs_error_plot(title: &str, rows: &[ModelRow]) -> flexmb_plot::Plot {
     let mut p = flexmb_plot::Plot::new(
         title,
-        "log10 wall time of the integration (s)",
-        "log10 largest relative error (eigenfrequencies, time response)",
-    );
+        "wall time of the integration",
+        "largest relative error (eigenfrequencies, time response)",
+    )
+    .log_x()
+    .log_y()
+    .x_unit("s")
+    .y_unit("%")
+    .without_legend();
     for r in rows {
         let e = r
             .freq_error
@@ -234,12 +235,46 @@ pub fn speed_vs_error_plot(
             .chain(r.response_error.iter().map(|(_, _, m, s)| m / s))
             .fold(0.0f64, f64::max);
         if e > 0.0 && r.wall_time > 0.0 {
-            p.push(flexmb_plot::Series::points(
+            p.push(flexmb_plot::Series::labelled_point(
                 &r.name,
-                &[r.wall_time.log10()],
-                &[e.log10()],
+                r.wall_time,
+                100.0 * e,
             ));
         }
     }
-    p.save(path)
+    p
+}
+
+/// The figures of one report: each saved as SVG and PNG side by side, and
+/// listed in the Markdown with its PNG embedded and its SVG linked.
+#[derive(Default)]
+pub struct Figures {
+    saved: Vec<(String, String)>,
+}
+
+impl Figures {
+    /// Saves `plot` as `dir/stem.svg` and `dir/stem.png`.
+    pub fn save(
+        &mut self,
+        plot: &flexmb_plot::Plot,
+        dir: &std::path::Path,
+        stem: &str,
+    ) -> std::io::Result<()> {
+        plot.save_both(&dir.join(stem))?;
+        self.saved.push((stem.into(), plot.title().into()));
+        Ok(())
+    }
+
+    /// The Markdown of the figures whose file stem passes `pick`, in the
+    /// order they were saved.
+    pub fn markdown(&self, pick: impl Fn(&str) -> bool) -> String {
+        let mut s = String::new();
+        for (stem, title) in self.saved.iter().filter(|(f, _)| pick(f)) {
+            let _ = writeln!(
+                s,
+                "![{title}]({stem}.png)\n\n`{stem}` ([SVG]({stem}.svg))\n"
+            );
+        }
+        s
+    }
 }

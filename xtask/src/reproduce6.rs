@@ -5,7 +5,8 @@ use crate::ch6::{self, Ch6Options, Models, NODE};
 use crate::models::{simulate, CurvePoint, Model, Response};
 use crate::progress::Progress;
 use crate::report::{
-    interpolate, pct, rms_and_max, sig, speed_vs_error_plot, speed_vs_error_table, ModelRow, Table,
+    interpolate, pct, rms_and_max, sig, speed_vs_error_plot, speed_vs_error_table, Figures,
+    ModelRow, Table,
 };
 use flexmb_dynamics::{Integrator, SimulationOptions};
 use flexmb_plot::{write_csv, Plot, Series};
@@ -160,7 +161,8 @@ fn write_outputs(
         s.write(&cdir, &ch6::provenance(opts, setup))?;
     }
     // eigenfrequency figures
-    let fig = |file: &str, title: &str, names: &[&str], k: usize| -> std::io::Result<()> {
+    let mut figs = Figures::default();
+    let mut fig = |file: &str, title: &str, names: &[&str], k: usize| -> std::io::Result<()> {
         let mut p = Plot::new(
             title,
             "x-displacement of the intermediate body (mm)",
@@ -180,79 +182,84 @@ fn write_outputs(
                 Series::dashed(n, &x, &y)
             });
         }
-        p.save(&out.join(file))
+        figs.save(&p, out, file)
     };
     let fbm = ["Unreduced", "MODAL-2", "SVD-7", "SVD-13"];
     let ibm = ["Unreduced", "MSI-2", "MSI-7", "MSI-7g", "MAC-7"];
     fig(
-        "fig6_9a_fbm_omega1.svg",
+        "fig6_9a_fbm_omega1",
         "Fig. 6.9a: first eigenfrequency, FBM",
         &fbm,
         0,
     )?;
     fig(
-        "fig6_9b_fbm_omega2.svg",
+        "fig6_9b_fbm_omega2",
         "Fig. 6.9b: second eigenfrequency, FBM",
         &fbm,
         1,
     )?;
     fig(
-        "fig6_10a_fbm_omega3.svg",
+        "fig6_10a_fbm_omega3",
         "Fig. 6.10: third eigenfrequency, FBM",
         &["Unreduced", "SVD-13"],
         2,
     )?;
     fig(
-        "fig6_10b_fbm_omega4.svg",
+        "fig6_10b_fbm_omega4",
         "Fig. 6.10: fourth eigenfrequency, FBM",
         &["Unreduced", "SVD-13"],
         3,
     )?;
     fig(
-        "fig6_12a_ibm_omega1.svg",
+        "fig6_12a_ibm_omega1",
         "Fig. 6.12a: first eigenfrequency, IBM",
         &ibm,
         0,
     )?;
     fig(
-        "fig6_12b_ibm_omega2.svg",
+        "fig6_12b_ibm_omega2",
         "Fig. 6.12b: second eigenfrequency, IBM",
         &ibm,
         1,
     )?;
     let ibm7 = ["Unreduced", "MSI-7", "MSI-7g", "MAC-7"];
     fig(
-        "fig6_13a_ibm_omega3.svg",
+        "fig6_13a_ibm_omega3",
         "Fig. 6.13: third eigenfrequency, IBM",
         &ibm7,
         2,
     )?;
     fig(
-        "fig6_13b_ibm_omega4.svg",
+        "fig6_13b_ibm_omega4",
         "Fig. 6.13: fourth eigenfrequency, IBM",
         &ibm7,
         3,
     )?;
     // singular values (Figs 6.7, 6.8)
     // the selection rule drawn as a line: 1 % per mode, FINAL_SVD_THRESHOLD for step 9
-    let sv = |file: &str, title: &str, v: &[f64], rule: f64| -> std::io::Result<()> {
+    let mut sv = |file: &str, title: &str, v: &[f64], rule: f64| -> std::io::Result<()> {
         let k: Vec<f64> = (1..=v.len()).map(|i| i as f64).collect();
         let pc: Vec<f64> = v.iter().map(|x| 100.0 * x).collect();
         let label = format!("{} % (kept above)", 100.0 * rule);
-        Plot::new(title, "singular vector", "singular value (% of the sum)")
-            .log_y()
-            .series(Series::points("singular values", &k, &pc))
-            .series(Series::dashed(
-                &label,
-                &[1.0, v.len() as f64],
-                &[100.0 * rule; 2],
-            ))
-            .save(&out.join(file))
+        let p = Plot::new(
+            title,
+            "singular vector",
+            "singular value relative to the sum",
+        )
+        .log_y()
+        .y_unit("%")
+        .series(Series::points("singular values", &k, &pc))
+        .series(Series::dashed(
+            &label,
+            &[1.0, v.len() as f64],
+            &[100.0 * rule; 2],
+        ));
+        figs.save(&p, out, file)
     };
     for (j, rel, _) in &models.svd13.per_mode {
         let n = rel.len().min(30);
         sv(
-            &format!("fig6_7_mode{}_singular_values.svg", j + 1),
+            &format!("fig6_7_mode{}_singular_values", j + 1),
             &format!(
                 "Fig. 6.7: SVD of mode {} over {} configurations",
                 j + 1,
@@ -263,13 +270,13 @@ fn write_outputs(
         )?;
     }
     sv(
-        "fig6_8a_svd7_singular_values.svg",
+        "fig6_8a_svd7_singular_values",
         "Fig. 6.8a: SVD of the collected vectors, SVD-7",
         &models.svd7.final_relative,
         flexmb_reduction::FINAL_SVD_THRESHOLD,
     )?;
     sv(
-        "fig6_8b_svd13_singular_values.svg",
+        "fig6_8b_svd13_singular_values",
         "Fig. 6.8b: SVD of the collected vectors, SVD-13",
         &models.svd13.final_relative,
         flexmb_reduction::FINAL_SVD_THRESHOLD,
@@ -294,11 +301,11 @@ fn write_outputs(
         })
         .collect();
     write_csv(&out.join("responses.csv"), &["displacements of node S (m) against time (s); all models start from their static equilibrium under gravity".into()], &header, &rows)?;
-    let resp_fig = |file: &str,
-                    title: &str,
-                    names: &[&str],
-                    comp: usize,
-                    label: &str|
+    let mut resp_fig = |file: &str,
+                        title: &str,
+                        names: &[&str],
+                        comp: usize,
+                        label: &str|
      -> std::io::Result<()> {
         let mut p = Plot::new(title, "t (s)", label);
         for (i, n) in names.iter().enumerate() {
@@ -311,24 +318,24 @@ fn write_outputs(
                 });
             }
         }
-        p.save(&out.join(file))
+        figs.save(&p, out, file)
     };
     resp_fig(
-        "fig6_6_x_response.svg",
+        "fig6_6_x_response",
         "Fig. 6.6: x-displacement of the intermediate body",
         &["Unreduced"],
         0,
         "x (mm)",
     )?;
     resp_fig(
-        "fig6_11_fbm_z_response.svg",
+        "fig6_11_fbm_z_response",
         "Fig. 6.11: z-displacement at s, FBM",
         &fbm,
         2,
         "z (mm)",
     )?;
     resp_fig(
-        "fig6_14_ibm_z_response.svg",
+        "fig6_14_ibm_z_response",
         "Fig. 6.14: z-displacement at s, IBM",
         &ibm,
         2,
@@ -363,10 +370,10 @@ fn write_outputs(
             response_error: vec![("x".into(), xr, xm, x_scale), ("z".into(), zr, zm, z_scale)],
         });
     }
-    speed_vs_error_plot(
-        "Chapter 6: speed against error",
-        &rows_out[1..],
-        &out.join("speed_vs_error.svg"),
+    figs.save(
+        &speed_vs_error_plot("Chapter 6: speed against error", &rows_out[1..]),
+        out,
+        "speed_vs_error",
     )?;
     // report
     let mut s = String::new();
@@ -450,10 +457,13 @@ fn write_outputs(
         ]);
     }
     let _ = writeln!(s, "{}", t.render());
-    let _ = writeln!(s, "Figures: `fig6_9a_fbm_omega1.svg`, `fig6_9b_fbm_omega2.svg`, `fig6_10a/b_fbm_omega3/4.svg`, `fig6_12a/b_ibm_omega1/2.svg`, `fig6_13a/b_ibm_omega3/4.svg`; singular values `fig6_7_mode*.svg`, `fig6_8a/b_*.svg`; responses `fig6_6_x_response.svg`, `fig6_11_fbm_z_response.svg`, `fig6_14_ibm_z_response.svg`. Data: `curves/*.csv`, `responses.csv`.\n");
+    let _ = writeln!(s, "Data: `curves/*.csv`, `responses.csv`. Figures (each as SVG and PNG side by side) follow the speed-against-error table.\n");
     let _ = writeln!(s, "## Speed against error\n");
-    let _ = writeln!(s, "Errors with respect to the unreduced model integrated with Adams: eigenfrequency errors are the largest relative deviation over the stroke of each retained eigenfrequency (ω1–ω2 or ω1–ω4, compared at equal x-displacement); time-response errors are the RMS and maximum deviation of the x- and z-displacement of S over all outputs, relative to max |x| ({:.4} m) and to the peak-to-peak z ({:.3e} m) of the unreduced response. Wall time is the integration only (one core; the machine ran two jobs at once). Plot: `speed_vs_error.svg`.\n", x_scale, z_scale);
+    let _ = writeln!(s, "Errors with respect to the unreduced model integrated with Adams: eigenfrequency errors are the largest relative deviation over the stroke of each retained eigenfrequency (ω1–ω2 or ω1–ω4, compared at equal x-displacement); time-response errors are the RMS and maximum deviation of the x- and z-displacement of S over all outputs, relative to max |x| ({:.4} m) and to the peak-to-peak z ({:.3e} m) of the unreduced response. Wall time is the integration only (one core; the machine ran two jobs at once). \n", x_scale, z_scale);
     let _ = writeln!(s, "{}", speed_vs_error_table(&rows_out));
+    let _ = writeln!(s, "{}", figs.markdown(|f| f == "speed_vs_error"));
+    let _ = writeln!(s, "## Figures\n");
+    let _ = writeln!(s, "{}", figs.markdown(|f| f != "speed_vs_error"));
     std::fs::write(out.join("report.md"), s)?;
     Ok(rows_out)
 }

@@ -121,7 +121,7 @@ pub(crate) struct ReduceArgs {
     #[arg(long)]
     no_gravity: bool,
     /// The model file (RON). MODEL.frequencies.csv and, for the SVD methods,
-    /// MODEL.singular_values.csv and .svg are written next to it.
+    /// MODEL.singular_values.csv, .svg and .png are written next to it.
     #[arg(long, value_name = "MODEL.ron")]
     out: PathBuf,
 }
@@ -513,9 +513,10 @@ fn report_singular_values(sv: &[SingularValues], model: &Path) -> Result<Vec<Pat
     let mut plot = Plot::new(
         &format!("singular values of {}", model.display()),
         "singular vector",
-        "singular value (% of the sum)",
+        "singular value relative to the sum",
     )
-    .log_y();
+    .log_y()
+    .y_unit("%");
     for s in sv {
         let (k, pc): (Vec<f64>, Vec<f64>) = s
             .relative
@@ -527,8 +528,8 @@ fn report_singular_values(sv: &[SingularValues], model: &Path) -> Result<Vec<Pat
         plot.push(Series::points(&s.label, &k, &pc));
     }
     let svg = beside(model, "singular_values.svg");
-    plot.save(&svg).map_err(|e| io_err(e, &svg))?;
-    Ok(vec![csv, svg])
+    let (svg, png) = plot.save_both(&svg).map_err(|e| io_err(e, &svg))?;
+    Ok(vec![csv, svg, png])
 }
 
 /// `flexmb reduce`.

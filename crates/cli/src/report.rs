@@ -1,6 +1,6 @@
 //! What the commands write, shared by unreduced and reduced models: the time
-//! response table (`outputs.csv`/`.svg`, node paths), the eigenfrequency
-//! sweep (`eigenfrequencies.csv`/`.svg`) and progress bars.
+//! response table (`outputs.csv`/`.svg`/`.png`, node paths), the eigenfrequency
+//! sweep (`eigenfrequencies.csv`/`.svg`/`.png`) and progress bars.
 
 use crate::out::say;
 use crate::{finite, io_err, Failure};
@@ -86,9 +86,9 @@ pub(crate) fn summary(r: &Response) -> String {
 /// Writes `out/outputs.csv` (the scene's outputs, or the DOFs, at each output
 /// time, each from the configuration the run had there: `rows`, from
 /// [`MechanicalModel::simulate_outputs`](flexmb_reduction::MechanicalModel::simulate_outputs)),
-/// `out/outputs.svg` (the first
-/// twelve columns) and `out/path_N.svg` for every node N whose x and y are
-/// outputs.
+/// `out/outputs.svg` and `.png` (the first
+/// twelve columns) and `out/path_N.svg` and `.png` for every node N whose x
+/// and y are outputs.
 pub(crate) fn write_outputs(
     dy: &Dynamics,
     rows: OutputRows,
@@ -110,8 +110,13 @@ pub(crate) fn write_outputs(
         plot.push(Series::line(h, &t, &y));
     }
     let svg = out.join("outputs.svg");
-    plot.save(&svg).map_err(|e| io_err(e, &svg))?;
-    say!("wrote {} and {}", csv.display(), svg.display());
+    let (svg, png) = plot.save_both(&svg).map_err(|e| io_err(e, &svg))?;
+    say!(
+        "wrote {}, {} and {}",
+        csv.display(),
+        svg.display(),
+        png.display()
+    );
     // the path of every node whose position is an output (e.g. a manipulator tip)
     for (k, h) in table.header.iter().enumerate() {
         if let Some(node) = h.strip_suffix(".x") {
@@ -121,8 +126,8 @@ pub(crate) fn write_outputs(
                 let p = Plot::new(&format!("path of {node}"), "x (m)", "y (m)")
                     .series(Series::line(node, &x, &y));
                 let f = out.join(format!("path_{node}.svg"));
-                p.save(&f).map_err(|e| io_err(e, &f))?;
-                say!("wrote {}", f.display());
+                let (svg, png) = p.save_both(&f).map_err(|e| io_err(e, &f))?;
+                say!("wrote {} and {}", svg.display(), png.display());
             }
         }
     }
@@ -151,7 +156,7 @@ pub(crate) struct FrequencySweep<'a> {
 
 /// Writes `out/eigenfrequencies.csv` (the parameter, f1_hz … fk_hz, and
 /// `hold:NAME` for each held coordinate: the force that holds it) and
-/// `out/eigenfrequencies.svg`, plus `out/holding_force.svg` for a sweep over
+/// `out/eigenfrequencies.svg` and `.png`, plus `out/holding_force.svg` and `.png` for a sweep over
 /// held coordinates.
 pub(crate) fn write_frequency_sweep(
     sw: &FrequencySweep,
@@ -196,8 +201,13 @@ pub(crate) fn write_frequency_sweep(
         plot.push(Series::line(&format!("ω{}", i + 1), &sw.s, &f));
     }
     let svg = out.join("eigenfrequencies.svg");
-    plot.save(&svg).map_err(|e| io_err(e, &svg))?;
-    say!("wrote {} and {}", csv.display(), svg.display());
+    let (svg, png) = plot.save_both(&svg).map_err(|e| io_err(e, &svg))?;
+    say!(
+        "wrote {}, {} and {}",
+        csv.display(),
+        svg.display(),
+        png.display()
+    );
     if !held.is_empty() {
         let mut plot = Plot::new(
             &format!("{}: force holding the swept coordinates", sw.title),
@@ -209,8 +219,8 @@ pub(crate) fn write_frequency_sweep(
             plot.push(Series::line(h, &sw.s, &f));
         }
         let svg = out.join("holding_force.svg");
-        plot.save(&svg).map_err(|e| io_err(e, &svg))?;
-        say!("wrote {}", svg.display());
+        let (svg, png) = plot.save_both(&svg).map_err(|e| io_err(e, &svg))?;
+        say!("wrote {} and {}", svg.display(), png.display());
     }
     Ok(())
 }

@@ -45,6 +45,8 @@ fn simulate_writes_csv_and_plot() {
     assert!(std::fs::read_to_string(out.join("outputs.svg"))
         .unwrap()
         .contains("<polyline"));
+    let png = std::fs::read(out.join("outputs.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
     std::fs::remove_dir_all(&out).ok();
 }
 
@@ -147,6 +149,8 @@ fn eig_and_sweep_report_frequencies() {
     assert!(std::fs::read_to_string(out.join("eigenfrequencies.svg"))
         .unwrap()
         .contains("<polyline"));
+    let png = std::fs::read(out.join("eigenfrequencies.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
     let o = flexmb()
         .args([
             "sweep",
@@ -417,6 +421,8 @@ fn svd_modal_model_follows_the_load_where_the_modal_model_does_not() {
     assert!(std::fs::read_to_string(dir.join("svd.singular_values.svg"))
         .unwrap()
         .contains("<circle"));
+    let png = std::fs::read(dir.join("svd.singular_values.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
     let modal = dir.join("modal3.ron");
     run_ok(&[
         "reduce",
