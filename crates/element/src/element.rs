@@ -9,6 +9,7 @@ use crate::beam_matrices::{
 };
 use crate::custom::{CustomInertia, CustomKind, Erased, MAX_ELEMENT_COORDS};
 use crate::inertia::{psd_factor, PlanarInertia, SpatialInertia, VelocityTransform, MAX_MODES};
+use crate::initial_orientation::InitialFrames;
 use crate::kernels::{
     jacobian, second_directional, third_directional, weighted_hessian, DeformationKernel,
     NormalizationKernel, PlanarBeamKernel, PlanarHingeKernel, SpatialHingeKernel, TrussKernel,
@@ -156,6 +157,9 @@ pub struct Element {
     stiffness: DMatrix<f64>,
     damping: Option<DMatrix<f64>>,
     sigma0: Option<Vec<f64>>,
+    /// The initial orientations of rotated slots, if any
+    /// ([`with_initial_orientation`](Self::with_initial_orientation)).
+    initial: Option<InitialFrames>,
 }
 
 /// An orthonormal frame with x along `axis` and y as close as possible to `up`.
@@ -220,6 +224,7 @@ impl Element {
             stiffness,
             damping: None,
             sigma0: None,
+            initial: None,
         }
     }
 
@@ -750,6 +755,65 @@ impl Element {
         Ok(self)
     }
 
+    /// Starts orientation slot `slot` (an index into [`slots`](Self::slots))
+    /// rotated: `value` is the planar angle φ₀ (one value, rad) of an
+    /// [`Slot::Angle`] or the Euler parameters λ₀ (four values, unit within
+    /// 1e-9, then normalized) of an [`Slot::Orientation`]. The element is
+    /// then undeformed when that node's orientation is λ₀ (or φ₀) rather
+    /// than the identity: it sees the rotation since the start, λ ∘ λ₀*
+    /// (φ − φ₀), and all its derivatives follow by the chain rule exactly
+    /// (see `initial_orientation.rs`). Built-in and custom elements alike.
+    ///
+    /// Errors name the slot: not an orientation slot, a wrong number of
+    /// values, a non-finite or non-unit λ₀, or a slot given twice.
+    pub fn with_initial_orientation(
+        mut self,
+        slot: usize,
+        value: &[f64],
+    ) -> Result<Self, ElementError> {
+        let bad = |why: String| {
+            ElementError::Geometry(format!("initial orientation of slot {slot}: {why}"))
+        };
+        let kind = *self
+            .slots
+            .get(slot)
+            .ok_or_else(|| bad(format!("the element has {} slots", self.slots.len())))?;
+        let at: usize = self.slots[..slot].iter().map(Slot::len).sum();
+        let frames = self.initial.get_or_insert_with(InitialFrames::new);
+        if frames.has(at) {
+            return Err(bad("given twice".into()));
+        }
+        if value.iter().any(|v| !v.is_finite()) {
+            return Err(bad(format!("{value:?} is not finite")));
+        }
+        match (kind, value.len()) {
+            (Slot::Angle, 1) => frames.push_angle(at, value[0]),
+            (Slot::Orientation, 4) => {
+                let norm = value.iter().map(|v| v * v).sum::<f64>().sqrt();
+                if (norm - 1.0).abs() > 1e-9 {
+                    return Err(bad(format!(
+                        "the Euler parameters {value:?} have norm {norm}, not 1"
+                    )));
+                }
+                frames.push_euler(at, std::array::from_fn(|k| value[k] / norm));
+            }
+            (Slot::Angle, n) => return Err(bad(format!("an angle slot takes 1 value, not {n}"))),
+            (Slot::Orientation, n) => {
+                return Err(bad(format!(
+                    "an Euler-parameter slot takes 4 values, not {n}"
+                )))
+            }
+            (other, _) => return Err(bad(format!("a {other:?} slot has no orientation"))),
+        }
+        Ok(self)
+    }
+
+    /// Whether some orientation slot starts rotated
+    /// ([`with_initial_orientation`](Self::with_initial_orientation)).
+    pub fn has_initial_orientation(&self) -> bool {
+        self.initial.as_ref().is_some_and(|f| !f.is_empty())
+    }
+
     /// Sets the initial stress resultants σ0.
     pub fn with_initial_stress(mut self, s0: Vec<f64>) -> Result<Self, ElementError> {
         if s0.len() != self.n_eps() || s0.iter().any(|v| !v.is_finite()) {
@@ -884,12 +948,9 @@ impl Element {
 pub const FLIP_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
 
 impl Element {
-    /// The cosines of the angles between the element's chord p → q and the
-    /// local x axes of its p and q node frames at x, for the elements whose
-    /// deformations are periodic in them (planar and spatial beams,
-    /// superelements); `None` for the others (trusses have no frames, hinge
-    /// angles are unwrapped over turns, masses have no deformations).
-    pub fn chord_cosines(&self, x: &[f64]) -> Option<[f64; 2]> {
+    /// [`Self::chord_cosines`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn chord_cosines_local(&self, x: &[f64]) -> Option<[f64; 2]> {
         match &self.kind {
             Kind::PlanarBeam(k, _) => Some(k.chord_cosines(x)),
             Kind::TwoNode { kernel, .. } => Some(kernel.chord_cosines(x)),
@@ -935,9 +996,9 @@ impl Element {
         }
     }
 
-    /// ε = D(x). `prev` (the previous deformations) keeps hinge angles continuous
-    /// over many turns; pass `None` for the principal value.
-    pub fn deformations(&self, x: &[f64], prev: Option<&[f64]>, eps: &mut [f64]) {
+    /// [`Self::deformations`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn deformations_local(&self, x: &[f64], prev: Option<&[f64]>, eps: &mut [f64]) {
         macro_rules! go {
             ($k:expr, $nx:literal, $ne:literal) => {{
                 let xa: [f64; $nx] = std::array::from_fn(|i| x[i]);
@@ -980,8 +1041,9 @@ impl Element {
         }
     }
 
-    /// ε = D(x) and D,x (row-major n_ε × n_x).
-    pub fn deformations_and_jacobian(
+    /// [`Self::deformations_and_jacobian`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn deformations_and_jacobian_local(
         &self,
         x: &[f64],
         prev: Option<&[f64]>,
@@ -1015,9 +1077,15 @@ impl Element {
         }
     }
 
-    /// The directional second derivative D,xx\[a, b\] (length n_ε): the
-    /// convective term with a = b = ẋ.
-    pub fn deformation_second_derivative(&self, x: &[f64], a: &[f64], b: &[f64], out: &mut [f64]) {
+    /// [`Self::deformation_second_derivative`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn deformation_second_derivative_local(
+        &self,
+        x: &[f64],
+        a: &[f64],
+        b: &[f64],
+        out: &mut [f64],
+    ) {
         macro_rules! go {
             ($k:expr, $nx:literal, $ne:literal) => {{
                 let xa: [f64; $nx] = std::array::from_fn(|i| x[i]);
@@ -1037,9 +1105,9 @@ impl Element {
         }
     }
 
-    /// The directional third derivative D,xxx\[a, b, c\] (length n_ε), needed by
-    /// the linearization of the convective terms (thesis (E.5f)).
-    pub fn deformation_third_derivative(
+    /// [`Self::deformation_third_derivative`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn deformation_third_derivative_local(
         &self,
         x: &[f64],
         a: &[f64],
@@ -1064,9 +1132,9 @@ impl Element {
         }
     }
 
-    /// The weighted Hessian Σᵢ wᵢ Dᵢ,xx (row-major n_x × n_x): the element's
-    /// contribution to the geometric stiffness.
-    pub fn deformation_weighted_hessian(&self, x: &[f64], w: &[f64], out: &mut [f64]) {
+    /// [`Self::deformation_weighted_hessian`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn deformation_weighted_hessian_local(&self, x: &[f64], w: &[f64], out: &mut [f64]) {
         let nx = self.n_x();
         out[..nx * nx].fill(0.0);
         macro_rules! go {
@@ -1185,9 +1253,9 @@ fn force_derivatives<I: InertiaForce, const N: usize>(
 }
 
 impl Element {
-    /// The mass matrix over the local nodal coordinates (row-major n_x × n_x);
-    /// zero for massless elements.
-    pub fn mass_matrix(&self, x: &[f64], out: &mut [f64]) {
+    /// [`Self::mass_matrix`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn mass_matrix_local(&self, x: &[f64], out: &mut [f64]) {
         let n = self.n_x();
         out[..n * n].fill(0.0);
         match &self.kind {
@@ -1226,15 +1294,9 @@ impl Element {
         }
     }
 
-    /// TᵀM(x)T for the local coordinates in which the Euler parameters of
-    /// orientation slot k (in slot order) are replaced through
-    /// `bases[k] = Some(P)` (λ̇ = P a with P 4 × 3, e.g. Λᵀ(λ), whose
-    /// columns span the tangent space of the normalization), row-major in
-    /// the reduced coordinates (slot order, three per replaced orientation).
-    /// Returns the order of the result; `None` for elements without
-    /// co-rotational spatial inertia (apply T to
-    /// [`mass_matrix`](Self::mass_matrix) then).
-    pub fn mass_matrix_with_bases(
+    /// [`Self::mass_matrix_with_bases`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn mass_matrix_with_bases_local(
         &self,
         x: &[f64],
         bases: &[Option<[[f64; 3]; 4]>],
@@ -1249,13 +1311,9 @@ impl Element {
         }
     }
 
-    /// A factor R of the mass matrix, M = RᵀR (row-major m × n_x with
-    /// m ≤ n_x), written to `out`; returns m (0 for massless elements). For
-    /// co-rotational inertia R = Ū B̂ with the constant M̄ = ŪᵀŪ, so that
-    /// Fᵀ M F = (R F)ᵀ(R F) needs no n_x × n_x product (thesis (3.31), (D.10)).
-    /// `None` if M has no such factor (an indefinite M̄); use
-    /// [`mass_matrix`](Self::mass_matrix) then.
-    pub fn mass_factor(&self, x: &[f64], out: &mut [f64]) -> Option<usize> {
+    /// [`Self::mass_factor`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn mass_factor_local(&self, x: &[f64], out: &mut [f64]) -> Option<usize> {
         let n = self.n_x();
         match &self.kind {
             Kind::PlanarBeam(_, Some(i)) => i.mass_factor(x, out),
@@ -1269,7 +1327,7 @@ impl Element {
             | Kind::PointMass { .. } => {
                 // constant and at most 6 × 6
                 let mut m = [0.0; 36];
-                self.mass_matrix(x, &mut m);
+                self.mass_matrix_local(x, &mut m);
                 let u = psd_factor(&m[..n * n], n)?;
                 out[..n * n].copy_from_slice(&u);
                 Some(n)
@@ -1293,8 +1351,9 @@ impl Element {
         }
     }
 
-    /// The inertia force M ẍ + h(x, ẋ) (thesis (2.40a), (3.34)).
-    pub fn inertia_force(&self, x: &[f64], xd: &[f64], xdd: &[f64], out: &mut [f64]) {
+    /// [`Self::inertia_force`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn inertia_force_local(&self, x: &[f64], xd: &[f64], xdd: &[f64], out: &mut [f64]) {
         let n = self.n_x();
         match &self.kind {
             Kind::PlanarBeam(_, Some(i)) => i.force(x, xd, xdd, out),
@@ -1308,7 +1367,7 @@ impl Element {
             | Kind::PointMass { .. } => {
                 // constant mass matrix: h = 0
                 let mut m = [0.0; 36];
-                self.mass_matrix(x, &mut m);
+                self.mass_matrix_local(x, &mut m);
                 for r in 0..n {
                     out[r] = (0..n).map(|c| m[r * n + c] * xdd[c]).sum();
                 }
@@ -1335,9 +1394,9 @@ impl Element {
         self.inertia_force(x, xd, &zero[..self.n_x()], out)
     }
 
-    /// ∂(M ẍ + h)/∂x and ∂h/∂ẋ (row-major n_x × n_x each), exact (Appendix E
-    /// needs them for the N and C matrices). ∂/∂ẍ is the mass matrix.
-    pub fn inertia_force_derivatives(
+    /// [`Self::inertia_force_derivatives`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn inertia_force_derivatives_local(
         &self,
         x: &[f64],
         xd: &[f64],
@@ -1365,10 +1424,9 @@ impl Element {
         }
     }
 
-    /// The exact gravitational potential −m g·r_c where the element's centre
-    /// of mass follows from its coordinates exactly (point masses); `None` for
-    /// elements whose consistent gravity force has no closed-form potential here.
-    pub fn gravity_potential(&self, x: &[f64], g: &[f64; 3]) -> Option<f64> {
+    /// [`Self::gravity_potential`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn gravity_potential_local(&self, x: &[f64], g: &[f64; 3]) -> Option<f64> {
         match &self.kind {
             Kind::PointMass { m } => Some(-m * (g[0] * x[0] + g[1] * x[1] + g[2] * x[2])),
             Kind::PlanarMass { m, .. } => Some(-m * (g[0] * x[0] + g[1] * x[1])),
@@ -1377,8 +1435,9 @@ impl Element {
         }
     }
 
-    /// Kinetic energy T(x, ẋ).
-    pub fn kinetic_energy(&self, x: &[f64], xd: &[f64]) -> f64 {
+    /// [`Self::kinetic_energy`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn kinetic_energy_local(&self, x: &[f64], xd: &[f64]) -> f64 {
         match &self.kind {
             Kind::PlanarBeam(_, Some(i)) => i.kinetic_energy(x, xd),
             Kind::TwoNode {
@@ -1391,7 +1450,7 @@ impl Element {
             | Kind::PointMass { .. } => {
                 let n = self.n_x();
                 let mut m = [0.0; 36];
-                self.mass_matrix(x, &mut m);
+                self.mass_matrix_local(x, &mut m);
                 let mut e = 0.0;
                 for r in 0..n {
                     for c in 0..n {
@@ -1421,10 +1480,9 @@ impl Element {
         }
     }
 
-    /// The generalized force of gravity `g` (a uniform acceleration field),
-    /// f = M(x) ẋ_g with ẋ_g = g on every position coordinate: exact for rigid
-    /// motion of the element, including centre-of-mass offsets.
-    pub fn gravity_force(&self, x: &[f64], g: &[f64; 3], out: &mut [f64]) {
+    /// [`Self::gravity_force`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn gravity_force_local(&self, x: &[f64], g: &[f64; 3], out: &mut [f64]) {
         let n = self.n_x();
         match &self.kind {
             Kind::PlanarBeam(_, Some(i)) => i.gravity(x, g, out),
@@ -1450,7 +1508,7 @@ impl Element {
                     i += s.len();
                 }
                 let zero = [0.0; 6];
-                self.inertia_force(x, &zero, &xg, out);
+                self.inertia_force_local(x, &zero, &xg, out);
             }
             Kind::Custom(CustomKind {
                 inertia: Some(inertia),
@@ -1461,7 +1519,7 @@ impl Element {
                     CustomInertia::Energy(k) => k.gravity(x, &xg[..n], out),
                     CustomInertia::Constant(_) => {
                         let zero = [0.0; MAX_ELEMENT_COORDS];
-                        self.inertia_force(x, &zero[..n], &xg[..n], out);
+                        self.inertia_force_local(x, &zero[..n], &xg[..n], out);
                     }
                 }
             }
@@ -1469,9 +1527,9 @@ impl Element {
         }
     }
 
-    /// ∂f_gravity/∂x (row-major n_x × n_x): nonzero where the gravity force
-    /// depends on orientations.
-    pub fn gravity_force_derivative(&self, x: &[f64], g: &[f64; 3], out: &mut [f64]) {
+    /// [`Self::gravity_force_derivative`] in the element's own coordinates, where every
+    /// orientation slot starts at the identity.
+    fn gravity_force_derivative_local(&self, x: &[f64], g: &[f64; 3], out: &mut [f64]) {
         let n = self.n_x();
         out[..n * n].fill(0.0);
         macro_rules! go {
@@ -1519,5 +1577,240 @@ impl Element {
             i += s.len();
         }
         xg
+    }
+}
+
+/// The public evaluation functions: each maps the local coordinates through
+/// the element's initial orientations, if it has any (see
+/// `initial_orientation.rs`), and evaluates the element in its own
+/// coordinates.
+impl Element {
+    /// The cosines of the angles between the element's chord p → q and the
+    /// local x axes of its p and q node frames at x, for the elements whose
+    /// deformations are periodic in them (planar and spatial beams,
+    /// superelements); `None` for the others (trusses have no frames, hinge
+    /// angles are unwrapped over turns, masses have no deformations).
+    pub fn chord_cosines(&self, x: &[f64]) -> Option<[f64; 2]> {
+        match &self.initial {
+            None => self.chord_cosines_local(x),
+            Some(f) => self.chord_cosines_local(&f.point(x)),
+        }
+    }
+
+    /// ε = D(x). `prev` (the previous deformations) keeps hinge angles continuous
+    /// over many turns; pass `None` for the principal value.
+    pub fn deformations(&self, x: &[f64], prev: Option<&[f64]>, eps: &mut [f64]) {
+        match &self.initial {
+            None => self.deformations_local(x, prev, eps),
+            Some(f) => self.deformations_local(&f.point(x), prev, eps),
+        }
+    }
+
+    /// ε = D(x) and D,x (row-major n_ε × n_x).
+    pub fn deformations_and_jacobian(
+        &self,
+        x: &[f64],
+        prev: Option<&[f64]>,
+        eps: &mut [f64],
+        jac: &mut [f64],
+    ) {
+        match &self.initial {
+            None => self.deformations_and_jacobian_local(x, prev, eps, jac),
+            Some(f) => {
+                self.deformations_and_jacobian_local(&f.point(x), prev, eps, jac);
+                f.right(jac, self.n_eps(), self.n_x());
+            }
+        }
+    }
+
+    /// The directional second derivative D,xx\[a, b\] (length n_ε): the
+    /// convective term with a = b = ẋ.
+    pub fn deformation_second_derivative(&self, x: &[f64], a: &[f64], b: &[f64], out: &mut [f64]) {
+        match &self.initial {
+            None => self.deformation_second_derivative_local(x, a, b, out),
+            Some(f) => {
+                let n = self.n_x();
+                let (a, b) = (f.direction(&a[..n]), f.direction(&b[..n]));
+                self.deformation_second_derivative_local(&f.point(x), &a, &b, out)
+            }
+        }
+    }
+
+    /// The directional third derivative D,xxx\[a, b, c\] (length n_ε), needed by
+    /// the linearization of the convective terms (thesis (E.5f)).
+    pub fn deformation_third_derivative(
+        &self,
+        x: &[f64],
+        a: &[f64],
+        b: &[f64],
+        c: &[f64],
+        out: &mut [f64],
+    ) {
+        match &self.initial {
+            None => self.deformation_third_derivative_local(x, a, b, c, out),
+            Some(f) => {
+                let n = self.n_x();
+                let (a, b, c) = (
+                    f.direction(&a[..n]),
+                    f.direction(&b[..n]),
+                    f.direction(&c[..n]),
+                );
+                self.deformation_third_derivative_local(&f.point(x), &a, &b, &c, out)
+            }
+        }
+    }
+
+    /// The weighted Hessian Σᵢ wᵢ Dᵢ,xx (row-major n_x × n_x): the element's
+    /// contribution to the geometric stiffness.
+    pub fn deformation_weighted_hessian(&self, x: &[f64], w: &[f64], out: &mut [f64]) {
+        match &self.initial {
+            None => self.deformation_weighted_hessian_local(x, w, out),
+            Some(f) => {
+                self.deformation_weighted_hessian_local(&f.point(x), w, out);
+                f.congruence(out, self.n_x());
+            }
+        }
+    }
+
+    /// The mass matrix over the local nodal coordinates (row-major n_x × n_x);
+    /// zero for massless elements.
+    pub fn mass_matrix(&self, x: &[f64], out: &mut [f64]) {
+        match &self.initial {
+            None => self.mass_matrix_local(x, out),
+            Some(f) => {
+                self.mass_matrix_local(&f.point(x), out);
+                f.congruence(out, self.n_x());
+            }
+        }
+    }
+
+    /// TᵀM(x)T for the local coordinates in which the Euler parameters of
+    /// orientation slot k (in slot order) are replaced through
+    /// `bases[k] = Some(P)` (λ̇ = P a with P 4 × 3, e.g. Λᵀ(λ), whose
+    /// columns span the tangent space of the normalization), row-major in
+    /// the reduced coordinates (slot order, three per replaced orientation).
+    /// Returns the order of the result; `None` for elements without
+    /// co-rotational spatial inertia (apply T to
+    /// [`mass_matrix`](Self::mass_matrix) then).
+    pub fn mass_matrix_with_bases(
+        &self,
+        x: &[f64],
+        bases: &[Option<[[f64; 3]; 4]>],
+        out: &mut [f64],
+    ) -> Option<usize> {
+        match &self.initial {
+            None => self.mass_matrix_with_bases_local(x, bases, out),
+            Some(f) => {
+                let mut starts = vec![];
+                let mut at = 0;
+                for s in &self.slots {
+                    if matches!(s, Slot::Orientation) {
+                        starts.push(at);
+                    }
+                    at += s.len();
+                }
+                let bases = f.bases(bases, &starts);
+                self.mass_matrix_with_bases_local(&f.point(x), &bases, out)
+            }
+        }
+    }
+
+    /// A factor R of the mass matrix, M = RᵀR (row-major m × n_x with
+    /// m ≤ n_x), written to `out`; returns m (0 for massless elements). For
+    /// co-rotational inertia R = Ū B̂ with the constant M̄ = ŪᵀŪ, so that
+    /// Fᵀ M F = (R F)ᵀ(R F) needs no n_x × n_x product (thesis (3.31), (D.10)).
+    /// `None` if M has no such factor (an indefinite M̄); use
+    /// [`mass_matrix`](Self::mass_matrix) then.
+    pub fn mass_factor(&self, x: &[f64], out: &mut [f64]) -> Option<usize> {
+        match &self.initial {
+            None => self.mass_factor_local(x, out),
+            Some(f) => {
+                let m = self.mass_factor_local(&f.point(x), out)?;
+                f.right(out, m, self.n_x());
+                Some(m)
+            }
+        }
+    }
+
+    /// The inertia force M ẍ + h(x, ẋ) (thesis (2.40a), (3.34)).
+    pub fn inertia_force(&self, x: &[f64], xd: &[f64], xdd: &[f64], out: &mut [f64]) {
+        match &self.initial {
+            None => self.inertia_force_local(x, xd, xdd, out),
+            Some(f) => {
+                let n = self.n_x();
+                let (xd, xdd) = (f.direction(&xd[..n]), f.direction(&xdd[..n]));
+                self.inertia_force_local(&f.point(x), &xd, &xdd, out);
+                f.left_transposed(&mut out[..n], 1);
+            }
+        }
+    }
+
+    /// ∂(M ẍ + h)/∂x and ∂h/∂ẋ (row-major n_x × n_x each), exact (Appendix E
+    /// needs them for the N and C matrices). ∂/∂ẍ is the mass matrix.
+    pub fn inertia_force_derivatives(
+        &self,
+        x: &[f64],
+        xd: &[f64],
+        xdd: &[f64],
+        dfdx: &mut [f64],
+        dfdxd: &mut [f64],
+    ) {
+        match &self.initial {
+            None => self.inertia_force_derivatives_local(x, xd, xdd, dfdx, dfdxd),
+            Some(f) => {
+                let n = self.n_x();
+                let (xd, xdd) = (f.direction(&xd[..n]), f.direction(&xdd[..n]));
+                self.inertia_force_derivatives_local(&f.point(x), &xd, &xdd, dfdx, dfdxd);
+                f.congruence(dfdx, n);
+                f.congruence(dfdxd, n);
+            }
+        }
+    }
+
+    /// The exact gravitational potential −m g·r_c where the element's centre
+    /// of mass follows from its coordinates exactly (point masses); `None` for
+    /// elements whose consistent gravity force has no closed-form potential here.
+    pub fn gravity_potential(&self, x: &[f64], g: &[f64; 3]) -> Option<f64> {
+        match &self.initial {
+            None => self.gravity_potential_local(x, g),
+            Some(f) => self.gravity_potential_local(&f.point(x), g),
+        }
+    }
+
+    /// Kinetic energy T(x, ẋ).
+    pub fn kinetic_energy(&self, x: &[f64], xd: &[f64]) -> f64 {
+        match &self.initial {
+            None => self.kinetic_energy_local(x, xd),
+            Some(f) => {
+                let xd = f.direction(&xd[..self.n_x()]);
+                self.kinetic_energy_local(&f.point(x), &xd)
+            }
+        }
+    }
+
+    /// The generalized force of gravity `g` (a uniform acceleration field),
+    /// f = M(x) ẋ_g with ẋ_g = g on every position coordinate: exact for rigid
+    /// motion of the element, including centre-of-mass offsets.
+    pub fn gravity_force(&self, x: &[f64], g: &[f64; 3], out: &mut [f64]) {
+        match &self.initial {
+            None => self.gravity_force_local(x, g, out),
+            Some(f) => {
+                // ẋ_g has no orientation part: T ẋ_g = ẋ_g
+                self.gravity_force_local(&f.point(x), g, out);
+                f.left_transposed(&mut out[..self.n_x()], 1);
+            }
+        }
+    }
+
+    /// ∂f_gravity/∂x (row-major n_x × n_x): nonzero where the gravity force
+    /// depends on orientations.
+    pub fn gravity_force_derivative(&self, x: &[f64], g: &[f64; 3], out: &mut [f64]) {
+        match &self.initial {
+            None => self.gravity_force_derivative_local(x, g, out),
+            Some(f) => {
+                self.gravity_force_derivative_local(&f.point(x), g, out);
+                f.congruence(out, self.n_x());
+            }
+        }
     }
 }

@@ -45,6 +45,7 @@ mod beam_matrices;
 mod custom;
 mod element;
 mod inertia;
+mod initial_orientation;
 mod kernels;
 mod kinetic;
 mod section;

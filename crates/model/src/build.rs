@@ -13,7 +13,11 @@ use std::path::Path;
 #[derive(Clone, Debug)]
 enum Attach {
     Pos(String),
+    /// An orientation slot measured from the node's initial orientation.
     Orient(String),
+    /// An orientation slot whose element is given in the node's own axes
+    /// (a rigid body): it takes the node's orientation as it is.
+    Carried(String),
     Group(String),
 }
 
@@ -203,6 +207,7 @@ pub fn build_with_elements(
     let mut node_at: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut node_order: Vec<String> = vec![];
     let mut shares: HashMap<String, String> = HashMap::new();
+    let mut initial_orientation: HashMap<String, Vec<f64>> = HashMap::new();
     position_of_cycle(&scene.nodes)?;
     for n in &scene.nodes {
         if n.id.is_empty() {
@@ -253,6 +258,10 @@ pub fn build_with_elements(
                 kind: "node",
                 id: n.id.clone(),
             });
+        }
+        if let Some(o) = &n.orientation {
+            let values = crate::orientation::reference_values(&n.id, o, dim)?;
+            initial_orientation.insert(n.id.clone(), values);
         }
         node_order.push(n.id.clone());
     }
@@ -556,7 +565,7 @@ pub fn build_with_elements(
                     id: id.clone(),
                     group: id.clone(),
                     element,
-                    attach: vec![Attach::Pos(node.clone()), Attach::Orient(node.clone())],
+                    attach: vec![Attach::Pos(node.clone()), Attach::Carried(node.clone())],
                 });
             }
             ElementSpec::Superelement {
@@ -699,7 +708,7 @@ pub fn build_with_elements(
     for e in &expanded {
         for a in &e.attach {
             match a {
-                Attach::Orient(n) => {
+                Attach::Orient(n) | Attach::Carried(n) => {
                     needs_orient.insert(n.clone(), true);
                 }
                 Attach::Pos(n) => {
@@ -707,6 +716,14 @@ pub fn build_with_elements(
                 }
                 Attach::Group(_) => {}
             }
+        }
+    }
+    for n in &scene.nodes {
+        if n.orientation.is_some() && !needs_orient.get(&n.id).copied().unwrap_or(false) {
+            return Err(ModelError::invalid(
+                format!("node '{}' orientation", n.id),
+                "no element uses the node's orientation (only beams, hinges, superelements, rigid bodies and planar masses with inertia do); remove it or attach such an element",
+            ));
         }
     }
     let mut nodes = vec![];
@@ -731,12 +748,15 @@ pub fn build_with_elements(
             let start = x0.len();
             match dim {
                 Dimension::Planar => {
-                    x0.push(0.0);
+                    x0.push(initial_orientation.get(id).map_or(0.0, |v| v[0]));
                     x_names.push(format!("{id}.angle"));
                     Some(vec![start])
                 }
                 Dimension::Spatial => {
-                    x0.extend(EulerParameters::identity().0);
+                    match initial_orientation.get(id) {
+                        Some(l) => x0.extend(l),
+                        None => x0.extend(EulerParameters::identity().0),
+                    }
                     for k in 0..4 {
                         x_names.push(format!("{id}.l{k}"));
                     }
@@ -770,12 +790,27 @@ pub fn build_with_elements(
     // ---- place elements
     let mut elements = vec![];
     let mut eps_names = vec![];
-    for e in expanded {
+    for mut e in expanded {
+        for (k, a) in e.attach.iter().enumerate() {
+            if let Attach::Orient(n) = a {
+                match initial_orientation.get(n) {
+                    Some(v) if !crate::orientation::is_identity(v) => {
+                        e.element = e.element.with_initial_orientation(k, v).map_err(|err| {
+                            ModelError::Element {
+                                id: e.id.clone(),
+                                source: err,
+                            }
+                        })?;
+                    }
+                    _ => {}
+                }
+            }
+        }
         let mut x_index = vec![];
         for (slot, a) in e.element.slots().iter().zip(&e.attach) {
             match a {
                 Attach::Pos(n) => x_index.extend(&nodes[node_idx[n.as_str()]].position),
-                Attach::Orient(n) => x_index.extend(
+                Attach::Orient(n) | Attach::Carried(n) => x_index.extend(
                     nodes[node_idx[n.as_str()]]
                         .orientation
                         .as_ref()

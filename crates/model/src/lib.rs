@@ -34,6 +34,7 @@ mod loads;
 mod local_span;
 mod mechanism;
 mod naming;
+mod orientation;
 mod outputs;
 mod roles;
 mod scene;

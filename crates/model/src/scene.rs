@@ -75,6 +75,32 @@ pub struct NodeSpec {
     /// Share the position coordinates of this (earlier) node.
     #[serde(default)]
     pub position_of: Option<String>,
+    /// The orientation the node starts in (default: the global axes). The
+    /// elements on the node start undeformed in it; a rigid body's `com`
+    /// and `inertia` are given in the node's axes, so they turn with it.
+    #[serde(default)]
+    pub orientation: Option<OrientationSpec>,
+}
+
+/// An initial orientation of a node.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum OrientationSpec {
+    /// Spatial: a rotation by `angle` (rad) about `axis` (3 components, any
+    /// non-zero length), right-handed.
+    AxisAngle {
+        /// The axis (global).
+        axis: Vec<f64>,
+        /// The angle (rad).
+        angle: f64,
+    },
+    /// Spatial: the rotation vector θ n (rad, 3 components).
+    RotationVector(Vec<f64>),
+    /// Spatial: Euler parameters (λ0, λ1, λ2, λ3), λ0 the scalar part; unit
+    /// within 1e-9 (then normalized).
+    EulerParameters(Vec<f64>),
+    /// Planar: the angle φ (rad) counter-clockwise.
+    Angle(f64),
 }
 
 fn unique_material_ids<'de, D: serde::Deserializer<'de>>(

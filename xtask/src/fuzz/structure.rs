@@ -856,6 +856,7 @@ pub fn mutate(s: &mut Scene, rng: &mut Rng) -> String {
                     id: if rng.chance(0.5) { id } else { "N".into() },
                     at,
                     position_of: None,
+                    orientation: None,
                 },
                 "node",
             )

@@ -164,7 +164,43 @@ pub fn catalogue(rng: &mut StdRng) -> Vec<(String, Element)> {
             random_superelement(rng, 3, tr).0,
         ));
     }
+    // every element with an orientation slot again, its nodes starting in
+    // random, different orientations (Element::with_initial_orientation)
+    let rotated: Vec<(String, Element)> = v
+        .iter()
+        .filter(|(_, e)| {
+            e.slots()
+                .iter()
+                .any(|s| matches!(s, Slot::Angle | Slot::Orientation))
+        })
+        .map(|(name, e)| {
+            (
+                format!("{name} (nodes start rotated)"),
+                start_rotated(rng, e),
+            )
+        })
+        .collect();
+    v.extend(rotated);
     v
+}
+
+/// `e` with each orientation slot starting in a random orientation (angles
+/// up to 3 rad).
+pub fn start_rotated(rng: &mut StdRng, e: &Element) -> Element {
+    let mut e = e.clone();
+    for (k, s) in e.slots().to_vec().iter().enumerate() {
+        e = match s {
+            Slot::Angle => e
+                .with_initial_orientation(k, &[rng.random_range(-3.0..3.0)])
+                .unwrap(),
+            Slot::Orientation => e
+                .with_initial_orientation(k, &random_rotation(rng, 3.0).0)
+                .unwrap(),
+            _ => e,
+        };
+    }
+    assert!(e.has_initial_orientation());
+    e
 }
 
 /// A random configuration of an element: positions O(1), orientations random
