@@ -7,8 +7,8 @@ use super::Rng;
 use flexmb_element::VelocityTransform;
 use flexmb_model::{
     Component, ControllerSpec, Dimension, DofChoice, ElementEntry, ElementSpec, InitialVelocity,
-    LoadSpec, MaterialSpec, NodeSpec, OutputSpec, Prescribed, Scene, SectionSpec, Select,
-    TimeFunction,
+    LoadSpec, MaterialSpec, NodeSpec, OrientationSpec, OutputSpec, Prescribed, Scene, SectionSpec,
+    Select, TimeFunction,
 };
 
 /// A number: mostly near `v`, sometimes an unusual one.
@@ -755,10 +755,39 @@ fn convert_vectors(s: &mut Scene) {
     }
 }
 
+/// A node orientation: mostly valid forms of the scene's dimension, some of
+/// the other one, some degenerate (zero axis, non-unit, wrong length).
+fn orientation(rng: &mut Rng, nd: usize) -> Option<OrientationSpec> {
+    Some(match rng.below(6) {
+        0 => return None,
+        1 => OrientationSpec::AxisAngle {
+            axis: if rng.chance(0.1) {
+                vec![0.0; nd]
+            } else {
+                vector(rng, nd)
+            },
+            angle: number(rng, 1.0),
+        },
+        2 => OrientationSpec::RotationVector(vector(rng, nd)),
+        3 => {
+            let len = if rng.chance(0.9) { 4 } else { nd };
+            let mut l = vector(rng, len);
+            if rng.chance(0.7) {
+                let n = l.iter().map(|v| v * v).sum::<f64>().sqrt();
+                if n > 0.0 {
+                    l.iter_mut().for_each(|v| *v /= n);
+                }
+            }
+            OrientationSpec::EulerParameters(l)
+        }
+        _ => OrientationSpec::Angle(number(rng, 1.0)),
+    })
+}
+
 /// Applies one mutation to the scene and describes it.
 pub fn mutate(s: &mut Scene, rng: &mut Rng) -> String {
     let nd = dim_of(s);
-    match rng.below(24) {
+    match rng.below(25) {
         0 => {
             s.dimension = match s.dimension {
                 Dimension::Planar => Dimension::Spatial,
@@ -987,6 +1016,16 @@ pub fn mutate(s: &mut Scene, rng: &mut Rng) -> String {
                 _ => OutputSpec::Dofs,
             };
             list_op(&mut s.outputs, rng, |_| o, "output")
+        }
+        22 => {
+            if s.nodes.is_empty() {
+                return "no node".into();
+            }
+            let i = rng.below(s.nodes.len());
+            let o = orientation(rng, nd);
+            let n = &mut s.nodes[i];
+            n.orientation = o;
+            format!("node {:?} orientation {:?}", n.id, n.orientation)
         }
         _ => {
             let mut fs = functions(s);
