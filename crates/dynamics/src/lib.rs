@@ -135,9 +135,19 @@ pub enum DynamicsError {
     /// Invalid argument.
     #[error("{0}")]
     Invalid(String),
-    /// The integrator failed.
-    #[error("time integration failed: {0}")]
-    Integration(String),
+    /// The integrator failed. `source` is its error as it reported it, to
+    /// match on (e.g. [`OdeError::StepSizeTooSmall`](flexmb_ode::OdeError));
+    /// `message` says the same with the state's components named after the
+    /// mechanism's coordinates and, where there was one, the last evaluation
+    /// that failed before it (the reason a step size underflowed).
+    #[error("time integration failed: {message}")]
+    Integration {
+        /// The integrator's error.
+        #[source]
+        source: flexmb_ode::OdeError,
+        /// The error in the mechanism's terms.
+        message: String,
+    },
     /// Stopped on request ([`StaticOptions::stop`]).
     #[error("stopped on request")]
     Interrupted,

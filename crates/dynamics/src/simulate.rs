@@ -264,7 +264,10 @@ fn integrate_explicit_named<S: OdeSystem + ?Sized>(
         .last()
         .ok_or_else(|| DynamicsError::Invalid("no output times".into()))?;
     let out = Output::Times(opts.output_times.clone());
-    let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration(describe(&e));
+    let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration {
+        message: describe(&e),
+        source: e,
+    };
     let dim = sys.dim();
     let cell = RefCell::new(sys);
     let mut shared = Shared {
@@ -374,9 +377,14 @@ impl StepWatch {
     /// when there was one: a step-size underflow names its cause.
     fn with_cause(&self, e: DynamicsError) -> DynamicsError {
         match (&self.last_failure, e) {
-            (Some((t, m)), DynamicsError::Integration(msg)) => DynamicsError::Integration(format!(
-                "{msg}; the last evaluation that failed (at t = {t:e}): {m}"
-            )),
+            (Some((t, m)), DynamicsError::Integration { source, message }) => {
+                DynamicsError::Integration {
+                    source,
+                    message: format!(
+                        "{message}; the last evaluation that failed (at t = {t:e}): {m}"
+                    ),
+                }
+            }
             (_, e) => e,
         }
     }
@@ -718,8 +726,9 @@ impl Dynamics {
             c
         };
         let mech = self.mech.clone();
-        let to_err = |e: flexmb_ode::OdeError| {
-            DynamicsError::Integration(integration_error(&mech, StateLayout::SecondOrder, &e))
+        let to_err = |e: flexmb_ode::OdeError| DynamicsError::Integration {
+            message: integration_error(&mech, StateLayout::SecondOrder, &e),
+            source: e,
         };
         let (stats, stopped, switch_at) = match opts.integrator {
             Integrator::Dopri5 | Integrator::Adams => {
@@ -741,9 +750,7 @@ impl Dynamics {
                 let watch = sys.watch.expect("set above");
                 let (stats, stopped) = match run {
                     Ok(r) => r,
-                    Err(DynamicsError::Integration(m)) => {
-                        return Err(watch.with_cause(DynamicsError::Integration(m)))
-                    }
+                    Err(e @ DynamicsError::Integration { .. }) => return Err(watch.with_cause(e)),
                     Err(e) => return Err(e),
                 };
                 let switch_at = watch.switch_at;

@@ -48,6 +48,23 @@ fn a_mechanism_driven_out_of_reach_names_the_failing_equations() {
             msg.contains("the last evaluation that failed"),
             "{integrator:?}: the cause is missing: {msg}"
         );
+        // the integrator's own error is kept, to match on
+        match &err {
+            DynamicsError::Integration { source, .. } => {
+                let inner = std::error::Error::source(&err).map(|e| e.to_string());
+                assert_eq!(inner, Some(source.to_string()), "{integrator:?}");
+                assert!(
+                    matches!(
+                        source,
+                        flexmb_ode::OdeError::StepSizeTooSmall { .. }
+                            | flexmb_ode::OdeError::NewtonFailed { .. }
+                            | flexmb_ode::OdeError::Rhs { .. }
+                    ),
+                    "{integrator:?}: {source:?}"
+                );
+            }
+            other => panic!("{integrator:?}: not an integration error: {other:?}"),
+        }
         assert!(
             msg.contains("ab.") || msg.contains("bc.") || msg.contains("B.") || msg.contains("C."),
             "{integrator:?}: no element or node named: {msg}"

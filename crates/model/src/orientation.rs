@@ -58,7 +58,7 @@ pub(crate) fn reference_values(
             spatial_only("AxisAngle")?;
             let a = three("the axis", axis)?;
             finite(&[*angle])?;
-            if !(a.norm() > 0.0) {
+            if a.norm() == 0.0 {
                 return Err(ModelError::invalid(&ctx, "the axis has zero length"));
             }
             Ok(
