@@ -438,3 +438,46 @@ fn an_interrupted_reduced_sweep_exits_143_with_the_partial_frequencies() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The backstop: a stoppable phase that reaches no check within 1 s of the
+/// signal is forced out with the signal's code, writing nothing. The flexure
+/// chain with its beams split in 20 (1440 degrees of freedom): one eigen
+/// analysis of its sweep takes seconds with no check inside, so SIGINT 2 s
+/// into the sweep comes in one of them.
+#[test]
+fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
+    let dir = temp_dir("backstop");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(fixture("flexure_chain_720.ron")).unwrap();
+    assert_eq!(text.matches("n: 10)").count(), 12, "the fixture changed");
+    let scene = dir.join("chain_1440.ron");
+    std::fs::write(&scene, text.replace("n: 10)", "n: 20)")).unwrap();
+    let args = [
+        "sweep",
+        scene.to_str().unwrap(),
+        "--over",
+        "load",
+        "--from",
+        "0",
+        "--to",
+        "0.001",
+        "--n",
+        "3",
+        "--modes",
+        "2",
+    ];
+    let out = dir.join("sweep");
+    let mut child = start(&args, &out);
+    let _stdout = wait_until_computing(&mut child, Duration::from_secs(2));
+    send(&child, "INT");
+    // the grace time, then teardown
+    let (status, took, err) = wait_for_exit(&mut child, Duration::from_secs(3));
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("reached no point to stop at within 1 s; nothing written"),
+        "{err}"
+    );
+    assert!(took >= Duration::from_secs(1), "{took:?}: {err}");
+    assert!(!out.join("eigenfrequencies.csv").exists(), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
