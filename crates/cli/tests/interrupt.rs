@@ -374,3 +374,110 @@ fn a_closed_stdout_does_not_stop_the_files_or_change_the_exit_code() {
     assert_eq!(child.wait().unwrap().code(), Some(2));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `flexmb sweep --reduced` (a 3-coordinate modal model of the planar
+/// guidance, 30000 load scales): the reduced equilibria have nothing
+/// partial (exit at once), the eigen analyses after them do. SIGTERM some
+/// seconds in (in the eigen analyses on this machine) exits with 143 within
+/// [`EXIT_WITHIN`]; if it came in the eigen analyses, the rows written are
+/// the configurations reported, and the file says it is partial.
+#[test]
+fn an_interrupted_reduced_sweep_exits_143_with_the_partial_frequencies() {
+    let dir = temp_dir("reduced-sweep");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = fixture("straight_guidance_planar.ron");
+    let scene = scene.to_str().unwrap();
+    let model = dir.join("modal3.ron");
+    let o = Command::new(env!("CARGO_BIN_EXE_flexmb"))
+        .args([
+            "reduce", scene, "--method", "modal", "--modes", "3", "--out",
+        ])
+        .arg(&model)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let model = model.to_str().unwrap();
+    let args = [
+        "sweep",
+        scene,
+        "--reduced",
+        model,
+        "--over",
+        "load",
+        "--from",
+        "0",
+        "--to",
+        "1",
+        "--n",
+        "30000",
+        "--modes",
+        "2",
+    ];
+    let out = dir.join("sweep");
+    let mut child = start(&args, &out);
+    let _stdout = wait_until_computing(&mut child, Duration::from_secs(6));
+    send(&child, "TERM");
+    let (status, _, err) = wait_for_exit(&mut child, EXIT_WITHIN);
+    assert_eq!(status.code(), Some(143), "{err}");
+    let csv = out.join("eigenfrequencies.csv");
+    if err.contains("nothing partial to write") {
+        assert!(!csv.exists(), "{err}");
+    } else {
+        assert!(reported_stop_ms(&err) < STOP_WITHIN_MS, "{err}");
+        let (_, done) = err
+            .split_once("partial results written: ")
+            .unwrap_or_else(|| panic!("{err}"));
+        let done: usize = done.split(' ').next().unwrap().parse().unwrap();
+        assert!((1..30000).contains(&done), "{err}");
+        assert_eq!(rows(&csv).len(), done, "{err}");
+        let text = std::fs::read_to_string(&csv).unwrap();
+        assert!(
+            text.contains(&format!("# interrupted: {done} of 30000")),
+            "{text}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The backstop: a stoppable phase that reaches no check within 1 s of the
+/// signal is forced out with the signal's code, writing nothing. The flexure
+/// chain with its beams split in 20 (1440 degrees of freedom): one eigen
+/// analysis of its sweep takes seconds with no check inside, so SIGINT 2 s
+/// into the sweep comes in one of them.
+#[test]
+fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
+    let dir = temp_dir("backstop");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(fixture("flexure_chain_720.ron")).unwrap();
+    assert_eq!(text.matches("n: 10)").count(), 12, "the fixture changed");
+    let scene = dir.join("chain_1440.ron");
+    std::fs::write(&scene, text.replace("n: 10)", "n: 20)")).unwrap();
+    let args = [
+        "sweep",
+        scene.to_str().unwrap(),
+        "--over",
+        "load",
+        "--from",
+        "0",
+        "--to",
+        "0.001",
+        "--n",
+        "3",
+        "--modes",
+        "2",
+    ];
+    let out = dir.join("sweep");
+    let mut child = start(&args, &out);
+    let _stdout = wait_until_computing(&mut child, Duration::from_secs(2));
+    send(&child, "INT");
+    // the grace time, then teardown
+    let (status, took, err) = wait_for_exit(&mut child, Duration::from_secs(3));
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("reached no point to stop at within 1 s; nothing written"),
+        "{err}"
+    );
+    assert!(took >= Duration::from_secs(1), "{took:?}: {err}");
+    assert!(!out.join("eigenfrequencies.csv").exists(), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
