@@ -3,7 +3,7 @@
 //! as the command line drives them (crates/cli/src/main.rs), with numpy
 //! arrays in and out.
 
-use crate::errors::{self, FlexmbError};
+use crate::errors;
 use crate::reduce::{self, ReduceArgs};
 use crate::results::{arr3, mat, vec1, EigResult, SimulationResult, StaticResult, SweepResult};
 use crate::run::{self, Watch};
@@ -18,19 +18,7 @@ use flexmb::reduction::{MechanicalModel, ReducedModel as RsReduced, SavedBasis, 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
-use std::sync::{Arc, Mutex, MutexGuard};
-
-/// Locks a model for one call; a model busy in another thread is an error
-/// (waiting for it while holding the GIL could deadlock).
-fn lock<'a, T>(m: &'a Mutex<T>) -> PyResult<MutexGuard<'a, T>> {
-    match m.try_lock() {
-        Ok(g) => Ok(g),
-        Err(std::sync::TryLockError::Poisoned(p)) => Ok(p.into_inner()),
-        Err(std::sync::TryLockError::WouldBlock) => Err(FlexmbError::new_err(
-            "the model is busy with a computation in another thread; use one model per thread",
-        )),
-    }
-}
+use std::sync::Arc;
 
 /// Reads a sequence of floats (list, tuple or numpy array) named `what`.
 pub(crate) fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
@@ -293,7 +281,16 @@ fn finish<T: pyo3::PyClass + Into<pyo3::PyClassInitializer<T>>>(
 pub struct Model {
     mech: Arc<Mechanism>,
     scene: Scene,
-    dy: Mutex<Dynamics>,
+}
+
+impl Model {
+    /// Fresh equations of motion for one computation: every call starts
+    /// from the scene's reference state, as each `flexmb` command does, so
+    /// its numbers (down to the evaluation counts) do not depend on the
+    /// calls before it.
+    fn dynamics(&self) -> Dynamics {
+        Dynamics::new(self.mech.clone())
+    }
 }
 
 #[pymethods]
@@ -305,10 +302,8 @@ impl Model {
             s.scene.build(s.base_dir.as_deref())
         })?
         .map_err(errors::model)?;
-        let mech = Arc::new(mech);
         Ok(Self {
-            dy: Mutex::new(Dynamics::new(mech.clone())),
-            mech,
+            mech: Arc::new(mech),
             scene: scene.clone(),
         })
     }
@@ -335,9 +330,9 @@ impl Model {
                 "steps must be at least 1 (the number of load increments); got 0",
             ));
         }
-        let mut dy = lock(&self.dy)?;
+        let mut dy = self.dynamics();
         let q0 = self.mech.q0();
-        let dy = &mut *dy;
+        let dy = &mut dy;
         let sol = run::whole(py, "static", |w| {
             let opts = StaticOptions {
                 load_steps: steps,
@@ -382,8 +377,8 @@ impl Model {
     #[pyo3(signature = (k=None, static_first=false))]
     fn eig(&self, py: Python<'_>, k: Option<usize>, static_first: bool) -> PyResult<EigResult> {
         let k = modes_or_default(k, 10, self.mech.n_dof())?;
-        let mut dy = lock(&self.dy)?;
-        let dy = &mut *dy;
+        let mut dy = self.dynamics();
+        let dy = &mut dy;
         let q0 = self.mech.q0();
         let out = run::whole(py, "eig", |w| -> PyResult<_> {
             let q = if static_first {
@@ -533,8 +528,7 @@ impl Model {
         progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<SimulationResult> {
         let args = SimArgs::new(t_end, outputs, integrator, rtol, atol, static_first)?;
-        let mut dy = lock(&self.dy)?;
-        simulate_model(py, &mut *dy, args, progress)
+        simulate_model(py, &mut self.dynamics(), args, progress)
     }
 
     /// A reduced model q = G(z) of this model, as `flexmb reduce`: `method`
@@ -623,20 +617,25 @@ impl Model {
 pub struct ReducedModel {
     mech: Arc<Mechanism>,
     saved: SavedModel,
-    red: Mutex<RsReduced>,
+    n_z: usize,
 }
 
 impl ReducedModel {
+    /// The model `saved` of `mech`; ModelError if it does not fit.
     fn from_saved(py: Python<'_>, mech: Arc<Mechanism>, saved: SavedModel) -> PyResult<Self> {
         let m = mech.clone();
         let s = saved.clone();
-        let red = run::whole(py, "reduced model", |_| s.into_model(m))?
+        let n_z = run::whole(py, "reduced model", |_| s.into_model(m).map(|r| r.n_z()))?
             .map_err(|e| errors::ModelError::new_err(e.to_string()))?;
-        Ok(Self {
-            mech,
-            saved,
-            red: Mutex::new(red),
-        })
+        Ok(Self { mech, saved, n_z })
+    }
+
+    /// A fresh reduced model for one computation (as `flexmb simulate
+    /// --reduced` reads it), so that no call depends on the ones before.
+    fn model(&self) -> PyResult<RsReduced> {
+        self.saved
+            .into_model(self.mech.clone())
+            .map_err(|e| errors::ModelError::new_err(e.to_string()))
     }
 }
 
@@ -644,8 +643,8 @@ impl ReducedModel {
 impl ReducedModel {
     /// The number of reduced coordinates z.
     #[getter]
-    fn n_z(&self) -> PyResult<usize> {
-        Ok(lock(&self.red)?.n_z())
+    fn n_z(&self) -> usize {
+        self.n_z
     }
 
     /// How the basis was built.
@@ -663,7 +662,7 @@ impl ReducedModel {
     /// The unreduced mechanism's `info()` plus n_z and the description.
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = info_dict(py, &self.mech)?;
-        d.set_item("n_z", self.n_z()?)?;
+        d.set_item("n_z", self.n_z)?;
         d.set_item("description", &self.saved.description)?;
         Ok(d)
     }
@@ -680,10 +679,9 @@ impl ReducedModel {
     /// linearization (F.7) at the reference coordinates (default: all).
     #[pyo3(signature = (k=None))]
     fn eig<'py>(&self, py: Python<'py>, k: Option<usize>) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
-        let mut red = lock(&self.red)?;
-        let nz = red.n_z();
-        let k = modes_or_default(k, nz, nz)?;
-        let red = &mut *red;
+        let k = modes_or_default(k, self.n_z, self.n_z)?;
+        let mut red = self.model()?;
+        let red = &mut red;
         let f = run::whole(py, "eig", |_| {
             let z = red.reference_coordinates();
             red.eigenfrequencies(0.0, &z, k)
@@ -715,8 +713,7 @@ impl ReducedModel {
                  genalpha is for stiff unreduced models",
             ));
         }
-        let mut red = lock(&self.red)?;
-        simulate_model(py, &mut *red, args, progress)
+        simulate_model(py, &mut self.model()?, args, progress)
     }
 
     /// The reduced eigenfrequencies (F.7) at the reduced static equilibria
@@ -748,13 +745,13 @@ impl ReducedModel {
             )));
         }
         finite("t_load", t_load)?;
-        let mut red = lock(&self.red)?;
-        let k = modes.unwrap_or(6).min(red.n_z());
+        let mut red = self.model()?;
+        let k = modes.unwrap_or(6).min(self.n_z);
         if k == 0 {
             return Err(errors::argument("modes must be at least 1"));
         }
         let n = values.len();
-        let red = &mut *red;
+        let red = &mut red;
         let vals = &values;
         let (points, interrupt) = run::long(py, "sweep", progress, |w| {
             red.frequency_sweep(t_load, vals, k, &mut |d| {
@@ -786,7 +783,7 @@ impl ReducedModel {
     fn __repr__(&self) -> PyResult<String> {
         Ok(format!(
             "ReducedModel({} coordinates from {}: {})",
-            self.n_z()?,
+            self.n_z,
             self.mech.n_dof(),
             self.saved.description
         ))

@@ -93,15 +93,21 @@ def test_progress_callback_sees_the_run_advance():
     assert all(0.0 <= f <= 1.0 for f in seen)
 
 
-def test_failing_progress_callback_stops_the_run(guidance):
+def test_failing_progress_callback_stops_the_run():
+    model = flexmb.Model(flexmb.Scene.load(scene_path("straight_guidance_planar")))
+    seen = []
+
     def boom(fraction):
+        seen.append(fraction)
         if fraction > 0:
             raise RuntimeError("stop here")
 
     start = time.monotonic()
     with pytest.raises(RuntimeError, match="stop here"):
-        guidance.simulate(**LONG, progress=boom)
+        # progress is reported at the output times: many of them
+        model.simulate(t_end=1000.0, outputs=1000001, progress=boom)
     assert time.monotonic() - start < 5.0
+    assert seen[-1] < 0.01
 
 
 def test_progress_true_without_or_with_tqdm(guidance):
