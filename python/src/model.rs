@@ -63,7 +63,9 @@ fn finite(name: &str, value: f64) -> PyResult<()> {
 /// if that is fewer.
 fn modes_or_default(k: Option<usize>, default: usize, n: usize) -> PyResult<usize> {
     match k {
-        Some(0) => Err(errors::argument("k (the number of modes) must be at least 1")),
+        Some(0) => Err(errors::argument(
+            "k (the number of modes) must be at least 1",
+        )),
         Some(k) if k > n => Err(errors::argument(format!(
             "k = {k}: the model has {n} coordinates, so at most {n} modes"
         ))),
@@ -82,7 +84,11 @@ pub(crate) fn dof_index(mech: &Mechanism, name: &str, what: &str) -> PyResult<us
     {
         return Ok(k);
     }
-    let known = mech.x_names.iter().chain(&mech.eps_names).any(|x| x == name);
+    let known = mech
+        .x_names
+        .iter()
+        .chain(&mech.eps_names)
+        .any(|x| x == name);
     Err(errors::argument(if known {
         format!(
             "{what} '{name}' is a coordinate of the scene but not one of its degrees of freedom; \
@@ -139,7 +145,14 @@ fn columns(m: &Mat<f64>) -> Vec<Vec<f64>> {
 
 /// What a simulation returns from its worker: the run (or its error) and
 /// the output rows.
-type Run = Result<(flexmb::reduction::ModelTrajectory, Vec<Vec<f64>>, Vec<String>), PyErr>;
+type Run = Result<
+    (
+        flexmb::reduction::ModelTrajectory,
+        Vec<Vec<f64>>,
+        Vec<String>,
+    ),
+    PyErr,
+>;
 
 /// The options of one simulation, checked.
 struct SimArgs {
@@ -208,7 +221,8 @@ fn simulate_model<M: MechanicalModel + Send>(
         let cd0 = model
             .initial_velocities(0.0, &c0)
             .map_err(errors::reduction)?;
-        let table = OutputTable::new(model.dynamics()).map_err(|e| errors::argument(e.to_string()))?;
+        let table =
+            OutputTable::new(model.dynamics()).map_err(|e| errors::argument(e.to_string()))?;
         let header = table.header.clone();
         let mut observer = |t: f64| {
             w.progress(t / t_end);
@@ -352,7 +366,13 @@ impl Model {
         let disp: Vec<Vec<f64>> = m
             .nodes
             .iter()
-            .map(|n| n.position.iter().zip(&n.at).map(|(i, a)| sol.x[*i] - a).collect())
+            .map(|n| {
+                n.position
+                    .iter()
+                    .zip(&n.at)
+                    .map(|(i, a)| sol.x[*i] - a)
+                    .collect()
+            })
             .collect();
         Ok(StaticResult {
             q: vec1(py, sol.q.clone()),
@@ -490,7 +510,9 @@ impl Model {
             values: vec1(py, pts.iter().map(|p| p.s).collect()),
             frequencies: mat(
                 py,
-                &pts.iter().map(|p| p.frequencies_hz.clone()).collect::<Vec<_>>(),
+                &pts.iter()
+                    .map(|p| p.frequencies_hz.clone())
+                    .collect::<Vec<_>>(),
                 k,
             ),
             holding: mat(
@@ -596,7 +618,8 @@ impl Model {
     /// applied to this model; raises ModelError if it was built for other
     /// degrees of freedom.
     fn load_reduced(&self, py: Python<'_>, path: PathBuf) -> PyResult<ReducedModel> {
-        let saved = SavedModel::load(&path).map_err(|e| errors::SceneError::new_err(e.to_string()))?;
+        let saved =
+            SavedModel::load(&path).map_err(|e| errors::SceneError::new_err(e.to_string()))?;
         ReducedModel::from_saved(py, self.mech.clone(), saved)
     }
 
@@ -678,7 +701,11 @@ impl ReducedModel {
     /// The `k` lowest undamped eigenfrequencies (Hz) of the reduced rest
     /// linearization (F.7) at the reference coordinates (default: all).
     #[pyo3(signature = (k=None))]
-    fn eig<'py>(&self, py: Python<'py>, k: Option<usize>) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+    fn eig<'py>(
+        &self,
+        py: Python<'py>,
+        k: Option<usize>,
+    ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
         let k = modes_or_default(k, self.n_z, self.n_z)?;
         let mut red = self.model()?;
         let red = &mut red;
@@ -770,7 +797,10 @@ impl ReducedModel {
             values: vec1(py, values[..done].to_vec()),
             frequencies: mat(
                 py,
-                &points.into_iter().map(|p| p.frequencies).collect::<Vec<_>>(),
+                &points
+                    .into_iter()
+                    .map(|p| p.frequencies)
+                    .collect::<Vec<_>>(),
                 k,
             ),
             holding: mat(py, &vec![vec![]; done], 0),

@@ -98,7 +98,11 @@ impl ReduceArgs {
             wrong.push("over and values (modal uses the modes at the reference configuration)");
         }
         if !wrong.is_empty() {
-            return bad(format!("{} not for method={:?}", wrong.join(", "), m.name()));
+            return bad(format!(
+                "{} not for method={:?}",
+                wrong.join(", "),
+                m.name()
+            ));
         }
         if self.modes == 0 {
             return bad("modes must be at least 1".into());
@@ -137,7 +141,11 @@ impl ReduceArgs {
             return bad(format!(
                 "method={:?} builds its basis from a sweep: give over={} and values=[...]",
                 m.name(),
-                if m.is_ibm() { "COORD" } else { "\"load\" or COORD" }
+                if m.is_ibm() {
+                    "COORD"
+                } else {
+                    "\"load\" or COORD"
+                }
             ));
         };
         if m.is_ibm() {
@@ -230,7 +238,10 @@ pub fn build(
                 .map(|c| dof_index(mech, c, "keep"))
                 .collect::<PyResult<_>>()?;
             if let Some(c) = (0..keep.len()).find(|&i| keep[..i].contains(&keep[i])) {
-                return Err(errors::argument(format!("keep lists '{}' twice", a.keep[c])));
+                return Err(errors::argument(format!(
+                    "keep lists '{}' twice",
+                    a.keep[c]
+                )));
             }
             let b = modal_basis(mech, a.t_load, &q0, r, (!keep.is_empty()).then_some(&keep))
                 .map_err(errors::reduction)?;

@@ -130,16 +130,18 @@ fn to_value(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
         return Ok(Value::Bool(obj.extract()?));
     }
     if obj.is_instance_of::<PyInt>() {
-        let v: i64 = obj
-            .extract()
-            .map_err(|_| SceneError::new_err(format!("scene dict: {path}: integer out of range")))?;
+        let v: i64 = obj.extract().map_err(|_| {
+            SceneError::new_err(format!("scene dict: {path}: integer out of range"))
+        })?;
         return Ok(Value::from(v));
     }
     if obj.is_instance_of::<PyFloat>() {
         let v: f64 = obj.extract()?;
-        return serde_json::Number::from_f64(v).map(Value::Number).ok_or_else(|| {
-            SceneError::new_err(format!("scene dict: {path}: {v} is not a finite number"))
-        });
+        return serde_json::Number::from_f64(v)
+            .map(Value::Number)
+            .ok_or_else(|| {
+                SceneError::new_err(format!("scene dict: {path}: {v} is not a finite number"))
+            });
     }
     if obj.is_instance_of::<PyString>() {
         return Ok(Value::String(obj.extract()?));

@@ -30,17 +30,27 @@ def flexmb_bin() -> Path:
 
 
 @pytest.fixture(scope="session")
-def cli(flexmb_bin: Path):
-    """Runs the CLI with arguments, returning its stdout; fails on a non-zero exit."""
+def cli_run(flexmb_bin: Path):
+    """Runs the CLI with arguments, returning the completed process."""
 
-    def run(*args: object) -> str:
-        r = subprocess.run(
+    def run(*args: object) -> subprocess.CompletedProcess:
+        return subprocess.run(
             [str(flexmb_bin), *map(str, args)],
             capture_output=True,
             text=True,
             cwd=ROOT,
             timeout=600,
         )
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def cli(cli_run):
+    """Runs the CLI with arguments, returning its stdout; fails on a non-zero exit."""
+
+    def run(*args: object) -> str:
+        r = cli_run(*args)
         assert r.returncode == 0, f"flexmb {' '.join(map(str, args))} failed ({r.returncode}): {r.stderr}"
         return r.stdout
 
