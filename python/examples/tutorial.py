@@ -41,7 +41,8 @@ def guidance_sweep(out: Path) -> float:
     stored = np.array([[float(v) for v in row.split(",")] for row in rows])
     lam = stored[:, 0]
     # the scene's x-force acts at t = 0.05 s; the sweep scales it by lam
-    sweep = model.sweep(over="load", values=lam, modes=4, t_load=0.05, progress=True)
+    # a tqdm bar on a terminal (if tqdm is installed)
+    sweep = model.sweep(over="load", values=lam, modes=4, t_load=0.05, progress=sys.stderr.isatty())
     f = sweep.frequencies  # shape (61, 4), Hz
     worst = float(np.abs(f / stored[:, 2:6] - 1).max())
     print(f"{len(lam)} load scales, f1 from {f[:, 0].min():.3f} to {f[:, 0].max():.3f} Hz; "
