@@ -186,3 +186,47 @@ def test_build_superelement_matches_cli(cli, tmp_path):
     np.testing.assert_allclose(r.normal_frequencies, cli_hz, rtol=0, atol=6e-5)
     assert r.summary.splitlines()[0] == text.splitlines()[0]
     assert f"{12 + r.n_modes} coordinates" in r.summary.splitlines()[0]
+
+
+def cli_linspace(lo: float, hi: float, n: int) -> list:
+    """The sweep values of the CLI's --from/--to/--n, to the last bit."""
+    return [lo + (hi - lo) * i / (n - 1) for i in range(n)]
+
+
+def nodal_guidance() -> flexmb.Scene:
+    """The planar guidance with nodal DOFs and S.x first (docs/cli.md), made
+    by editing the scene's dict."""
+    d = flexmb.Scene.load(scene_path("straight_guidance_planar")).to_dict()
+    d["dofs"] = "NodalCoordinates"
+    d["dofs_first"] = [{"Coord": ["S", "X"]}]
+    return flexmb.Scene.from_dict(d)
+
+
+@pytest.mark.parametrize(
+    "method,modes,over,lo,hi,n,t_load",
+    [
+        ("svd-modal", 3, "load", -1.0, 1.0, 10, 0.05),
+        ("fbm-svd", 3, "load", -1.0, 1.0, 10, 0.05),
+        ("ibm-msi", 1, "S.x", -0.0834, 0.0834, 41, 0.0),
+        ("ibm-mac", 2, "S.x", -0.0834, 0.0834, 41, 0.0),
+    ],
+)
+def test_sweep_reductions_match_cli(method, modes, over, lo, hi, n, t_load, cli, tmp_path):
+    scene = nodal_guidance() if method.startswith("ibm") else flexmb.Scene.load(scene_path("straight_guidance_planar"))
+    scene_file = tmp_path / "scene.ron"
+    scene_file.write_text(scene.to_ron())
+    cli_model = tmp_path / "cli.ron"
+    cli("reduce", scene_file, "--method", method, "--modes", modes, "--over", over,
+        "--from", lo, "--to", hi, "--n", n, "--t-load", t_load, "--out", cli_model)
+    _, _, freqs = read_csv(tmp_path / "cli.frequencies.csv")
+    m = flexmb.Model(scene)
+    red = m.reduce(method=method, modes=modes, over=over, values=cli_linspace(lo, hi, n), t_load=t_load)
+    theirs = m.load_reduced(cli_model)
+    assert red.n_z == theirs.n_z == len(freqs)
+    assert red.description == theirs.description
+    assert red.interpolated == method.startswith("ibm")
+    np.testing.assert_allclose(red.eig(), freqs[:, 1], rtol=1e-10)
+    a = red.simulate(t_end=0.05, outputs=6)
+    b = theirs.simulate(t_end=0.05, outputs=6)
+    assert a.rhs_evals == b.rhs_evals
+    np.testing.assert_allclose(a.q, b.q, rtol=1e-10, atol=1e-13)
