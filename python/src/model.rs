@@ -234,7 +234,7 @@ fn simulate_model<M: MechanicalModel + Send>(
         Ok((traj, rows, header))
     };
     let (run, interrupt) = run::long(py, "simulate", progress, work)?;
-    let (traj, rows, header) = run?;
+    let ((traj, rows, header), interrupt) = run::settle(run, interrupt)?;
     let full = &traj.full;
     let n_q = model.dynamics().n_q();
     let nc = model.n_coordinates();
@@ -504,7 +504,7 @@ impl Model {
                 Some(&w.stop),
             )
         })?;
-        let outcome = outcome.map_err(errors::solver)?;
+        let (outcome, interrupt) = run::settle(outcome.map_err(errors::solver), interrupt)?;
         let pts = outcome.points;
         let result = SweepResult {
             values: vec1(py, pts.iter().map(|p| p.s).collect()),
@@ -791,7 +791,7 @@ impl ReducedModel {
                 }
             })
         })?;
-        let points = points.map_err(errors::reduction)?;
+        let (points, interrupt) = run::settle(points.map_err(errors::reduction), interrupt)?;
         let done = points.len();
         let result = SweepResult {
             values: vec1(py, values[..done].to_vec()),

@@ -143,3 +143,15 @@ pub fn whole<'py, T: Send>(
         None => Ok(r),
     }
 }
+
+/// The result of an interruptible run and its interrupt: a run that failed
+/// after the interrupt raises the interrupt (its failure is the stop's
+/// consequence, e.g. an equilibrium abandoned), one that failed without
+/// raises its error.
+pub fn settle<T>(result: PyResult<T>, interrupt: Option<PyErr>) -> PyResult<(T, Option<PyErr>)> {
+    match (result, interrupt) {
+        (Ok(r), i) => Ok((r, i)),
+        (Err(_), Some(i)) => Err(i),
+        (Err(e), None) => Err(e),
+    }
+}
