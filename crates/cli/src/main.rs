@@ -205,11 +205,26 @@ fn load(path: &Path) -> Result<(Scene, Arc<flexmb_model::Mechanism>), Failure> {
     Ok((scene, Arc::new(mech)))
 }
 
-/// Builds the mechanism of `scene` (read from `path`), with a spinner while
-/// it takes (the DOF choice of a large model).
+/// Builds the mechanism of `scene` (read from `path`), with a spinner that
+/// names the stage while it takes (the elements and the DOF choice of a
+/// large model), and on stderr the stages that took more than a second.
 fn build(scene: &Scene, path: &Path) -> Result<flexmb_model::Mechanism, Failure> {
-    let spinner = report::spinner("building the mechanism and choosing its degrees of freedom");
-    let mech = scene.build(path.parent());
+    let spinner = report::spinner("building the mechanism");
+    let mut stage: Option<(flexmb_model::BuildStage, std::time::Instant)> = None;
+    let mut done = |next: Option<flexmb_model::BuildStage>| {
+        if let Some((s, t)) = stage.take() {
+            let dt = t.elapsed().as_secs_f64();
+            if dt > 1.0 {
+                spinner.suspend(|| errln(&format!("{} took {dt:.1} s", s.describe())));
+            }
+        }
+        if let Some(s) = next {
+            spinner.set_message(format!("building the mechanism: {}", s.describe()));
+            stage = Some((s, std::time::Instant::now()));
+        }
+    };
+    let mech = scene.build_reporting(path.parent(), &mut |s| done(Some(s)));
+    done(None);
     spinner.finish_and_clear();
     mech.map_err(|e| match e {
         // a numerical failure on a valid scene, not bad input

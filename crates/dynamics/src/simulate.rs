@@ -634,7 +634,7 @@ impl Dynamics {
         let mut traj = Trajectory::empty();
         let (mut t, mut q, mut qd) = (t0, q0.to_vec(), qd0.to_vec());
         self.kinematics_at(t, &q, None)?;
-        if let Some((q1, qd1)) = self.switch_charts(t, &q, &qd, &mut traj.chart_switches)? {
+        if let Some((q1, qd1)) = self.switch_charts(t, &q, &qd, &[], &mut traj.chart_switches)? {
             (q, qd) = (q1, qd1);
         }
         let mut times = opts.output_times.clone();
@@ -665,7 +665,7 @@ impl Dynamics {
             t = ts;
             self.kinematics_at(t, &qs, None)?;
             (q, qd) = self
-                .switch_charts(t, &qs, &qds, &mut traj.chart_switches)?
+                .switch_charts(t, &qs, &qds, &[], &mut traj.chart_switches)?
                 .unwrap_or((qs, qds));
             times.retain(|&tau| tau > ts);
             if times.is_empty() {
@@ -830,18 +830,22 @@ impl Dynamics {
     /// Switches every chart that is no longer good at (t, q) (kinematics
     /// solved there): rebuilds the dynamics in the new chart, with its
     /// position solve starting from the current configuration, and returns
-    /// q, q̇ in it. `None` if no chart needs switching.
-    fn switch_charts(
+    /// q, q̇ in it. `None` if no chart needs switching. Charts whose
+    /// switch would change the coordinate in one of the DOF slots `keep`
+    /// (held by a static solve) stay.
+    pub(crate) fn switch_charts(
         &mut self,
         t: f64,
         q: &[f64],
         qd: &[f64],
+        keep: &[usize],
         log: &mut Vec<ChartSwitch>,
     ) -> Result<Option<(Q, Q)>, DynamicsError> {
         let charts = self.mech.euler_charts();
         let wanted: Vec<_> = charts
             .iter()
             .filter_map(|c| c.needs_switch(q).map(|s| (c, s)))
+            .filter(|(_, (slot, _))| !keep.contains(slot))
             .collect();
         if wanted.is_empty() {
             return Ok(None);

@@ -110,6 +110,12 @@ pub struct StaticSolution {
     pub increments: usize,
     /// Generalized reactions on the held degrees of freedom (the forces needed to hold them).
     pub reactions: Vec<f64>,
+    /// The Euler-parameter charts switched on the way (free orientations
+    /// turned by more than about 127° since their chart was chosen, see
+    /// `flexmb_model::EulerChart`). When there were any, `q` is in the
+    /// chart of [`Dynamics::mechanism`] after the call, not in the one
+    /// before it; `x` is the same in every chart.
+    pub chart_switches: Vec<flexmb_model::ChartSwitch>,
 }
 
 impl Dynamics {
@@ -473,6 +479,7 @@ impl Dynamics {
         let mut dh = vec![0.0; opts.held.len()];
         let mut x_ok = self.kin.x().to_vec();
         let mut x_good = x_ok.clone();
+        let mut chart_switches = vec![];
         while lambda < 1.0 - 1e-15 {
             let target = (lambda + dl).min(1.0);
             self.load_factor = if opts.ramp_loads { target } else { 1.0 };
@@ -638,6 +645,23 @@ impl Dynamics {
             if converged {
                 lambda = target;
                 increments += 1;
+                // a free orientation that turned far gets a regular chart
+                // before the next increment (the one it has is singular
+                // 180° from where it was chosen): q in the new chart, the
+                // same configuration
+                let q_here = q.clone();
+                let held_slots: Vec<usize> = opts.held.iter().map(|(i, _)| *i).collect();
+                if let Some((q1, _)) = self.switch_charts(
+                    t,
+                    &q_here,
+                    &vec![0.0; n_q],
+                    &held_slots,
+                    &mut chart_switches,
+                )? {
+                    q = q1;
+                    x_ok.copy_from_slice(self.kin.x());
+                    force_refresh = true;
+                }
                 last_good.copy_from_slice(&q);
                 x_good.copy_from_slice(&x_ok);
                 dl = (dl * 2.0).min(max_dl);
@@ -691,6 +715,7 @@ impl Dynamics {
             iterations,
             increments,
             reactions,
+            chart_switches,
         })
     }
 }

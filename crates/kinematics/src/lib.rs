@@ -127,7 +127,7 @@ pub enum KinematicsError {
     },
     /// The dependent Euler parameter of a node with the other three as DOFs
     /// approaches zero: the parametrization is singular there.
-    #[error("{coordinate} = {value:.3}, the Euler parameter made dependent by the normalization, approaches zero (the node is turned near 180° from where that chart was chosen): a simulation switches charts after each step (flexmb_model::EulerChart), but statics, sweeps and reduced models keep the chart of the reference configuration and cannot describe this rotation; keep the node within ±180° of its reference there, or give the rotation to a hinge deformation")]
+    #[error("{coordinate} = {value:.3}, the Euler parameter made dependent by the normalization, approaches zero (the node is turned near 180° from where that chart was chosen): simulations and static solves switch charts after each step or load increment (flexmb_model::EulerChart), so one step or increment turned the node too far (in statics: use more load steps); reduced models keep the chart of the reference configuration and cannot describe this rotation: keep the node within ±180° of its reference there, or give the rotation to a hinge deformation")]
     EulerParameterDegenerate {
         /// The coordinate.
         coordinate: String,

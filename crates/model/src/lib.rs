@@ -40,7 +40,7 @@ mod roles;
 mod scene;
 mod time_function;
 
-pub use build::CodeElement;
+pub use build::{BuildStage, CodeElement};
 pub use chart::{ChartSwitch, EulerChart, CHART_SWITCH_RATIO};
 pub use error::ModelError;
 pub use mechanism::*;
@@ -103,6 +103,16 @@ impl Scene {
         elements: &[CodeElement],
     ) -> Result<Mechanism, ModelError> {
         build::build_with_elements(self, base_dir, elements)
+    }
+
+    /// [`build`](Self::build) that calls `report` as each stage of the
+    /// build starts ([`BuildStage`]), for progress on large models.
+    pub fn build_reporting(
+        &self,
+        base_dir: Option<&Path>,
+        report: &mut dyn FnMut(BuildStage),
+    ) -> Result<Mechanism, ModelError> {
+        build::build_reporting(self, base_dir, &[], report)
     }
 
     /// Writes the scene as pretty RON.

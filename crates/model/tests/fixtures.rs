@@ -52,3 +52,37 @@ fn every_fixture_scene_parses_strictly_and_builds() {
     }
     assert!(n >= 9, "{n} scenes");
 }
+
+/// `build_reporting` names every stage once, in order, and builds the same
+/// mechanism as `build`; a scene that fails in the DOF choice has reported
+/// the stages before it and no later one.
+#[test]
+fn the_build_reports_its_stages_in_order() {
+    use flexmb_model::BuildStage::*;
+    let s = scene("straight_guidance_spatial.ron");
+    let mut seen = vec![];
+    let m = s.build_reporting(None, &mut |st| seen.push(st)).unwrap();
+    assert_eq!(
+        seen,
+        [
+            Nodes,
+            Elements,
+            Coordinates,
+            ReferenceConfiguration,
+            DegreesOfFreedom,
+            Loads
+        ]
+    );
+    assert_eq!(m.n_dof(), s.build(None).unwrap().n_dof());
+    // an unknown node in `fixed` fails in the roles: the stages before it
+    // were reported, no later one
+    let mut bad = scene("straight_guidance_planar.ron");
+    bad.fixed.push(flexmb_model::Select::Node("nowhere".into()));
+    let mut seen = vec![];
+    let err = bad
+        .build_reporting(None, &mut |st| seen.push(st))
+        .unwrap_err();
+    assert!(err.to_string().contains("nowhere"), "{err}");
+    assert_eq!(seen.last(), Some(&DegreesOfFreedom), "{seen:?}");
+    assert!(!seen.contains(&Loads));
+}
