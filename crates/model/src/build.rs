@@ -201,7 +201,7 @@ pub fn build_with_elements(
     build_reporting(scene, base_dir, extra, &mut |_| {})
 }
 
-/// A stage of [`build_reporting`], in the order they run. On a model of
+/// A stage of [`Scene::build_reporting`](crate::Scene::build_reporting), in the order they run. On a model of
 /// 10⁴–10⁵ coordinates the elements and the DOF choice take seconds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BuildStage {
