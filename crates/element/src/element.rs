@@ -9,7 +9,7 @@ use crate::beam_matrices::{
 };
 use crate::custom::{CustomInertia, CustomKind, Erased, MAX_ELEMENT_COORDS};
 use crate::inertia::{psd_factor, PlanarInertia, SpatialInertia, VelocityTransform, MAX_MODES};
-use crate::initial_orientation::InitialFrames;
+use crate::initial_orientation::{InitialFrames, MAX_ORIENTATION_SLOTS};
 use crate::kernels::{
     jacobian, second_directional, third_directional, weighted_hessian, DeformationKernel,
     NormalizationKernel, PlanarBeamKernel, PlanarHingeKernel, SpatialHingeKernel, TrussKernel,
@@ -1701,16 +1701,9 @@ impl Element {
         match &self.initial {
             None => self.mass_matrix_with_bases_local(x, bases, out),
             Some(f) => {
-                let mut starts = vec![];
-                let mut at = 0;
-                for s in &self.slots {
-                    if matches!(s, Slot::Orientation) {
-                        starts.push(at);
-                    }
-                    at += s.len();
-                }
-                let bases = f.bases(bases, &starts);
-                self.mass_matrix_with_bases_local(&f.point(x), &bases, out)
+                let mut mapped = [None; MAX_ORIENTATION_SLOTS];
+                let n = f.bases(bases, &self.slots, &mut mapped);
+                self.mass_matrix_with_bases_local(&f.point(x), &mapped[..n], out)
             }
         }
     }

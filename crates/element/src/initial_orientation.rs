@@ -21,6 +21,13 @@
 //! node carry the map, so the others pay nothing.
 
 use crate::custom::MAX_ELEMENT_COORDS;
+use crate::Slot;
+
+/// A 4 × 3 velocity basis of an orientation slot (λ̇ = P a).
+type Basis = [[f64; 3]; 4];
+
+/// The most orientation slots an element can have.
+pub(crate) const MAX_ORIENTATION_SLOTS: usize = MAX_ELEMENT_COORDS / 4;
 use flexmb_rotation::generic::compose;
 
 /// One rotated orientation slot.
@@ -155,31 +162,35 @@ impl InitialFrames {
         self.right(m, nx, nx);
     }
 
-    /// The 4 × 3 velocity bases P of orientation slots mapped to Q P, the
-    /// bases of λ̇' = Q λ̇ (for [`Element::mass_matrix_with_bases`](crate::Element::mass_matrix_with_bases)),
-    /// where `starts[k]` is the local index of orientation slot k.
+    /// The 4 × 3 velocity bases P of the orientation slots (in slot order,
+    /// as [`Element::mass_matrix_with_bases`](crate::Element::mass_matrix_with_bases)
+    /// takes them) mapped to Q P, the bases of λ̇' = Q λ̇, written to `out`
+    /// (no allocation); returns how many were written.
     pub fn bases(
         &self,
-        bases: &[Option<[[f64; 3]; 4]>],
-        starts: &[usize],
-    ) -> Vec<Option<[[f64; 3]; 4]>> {
-        bases
-            .iter()
-            .zip(starts)
-            .map(|(p, at)| {
-                let p = (*p)?;
+        bases: &[Option<Basis>],
+        slots: &[Slot],
+        out: &mut [Option<Basis>; MAX_ORIENTATION_SLOTS],
+    ) -> usize {
+        let mut at = 0;
+        let mut k = 0;
+        for s in slots {
+            if *s == Slot::Orientation && k < bases.len() {
                 let q = self.blocks.iter().find_map(|b| match b {
-                    Block::Euler { at: a, q } if a == at => Some(q),
+                    Block::Euler { at: a, q } if *a == at => Some(q),
                     _ => None,
                 });
-                Some(match q {
-                    None => p,
-                    Some(q) => std::array::from_fn(|r| {
-                        std::array::from_fn(|c| (0..4).map(|k| q[r][k] * p[k][c]).sum())
-                    }),
-                })
-            })
-            .collect()
+                out[k] = match (bases[k], q) {
+                    (Some(p), Some(q)) => Some(std::array::from_fn(|r| {
+                        std::array::from_fn(|c| (0..4).map(|i| q[r][i] * p[i][c]).sum())
+                    })),
+                    (p, _) => p,
+                };
+                k += 1;
+            }
+            at += s.len();
+        }
+        k
     }
 }
 
