@@ -5,6 +5,7 @@
 //! docs/reproduce.md and docs/cli.md.
 #![warn(missing_docs)]
 
+pub mod ch2;
 pub mod ch5;
 pub mod ch6;
 pub mod curves;

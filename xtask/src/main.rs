@@ -1,4 +1,4 @@
-//! `cargo xtask reproduce ch5|ch6|all`, `cargo xtask regress` and `cargo xtask fuzz`.
+//! `cargo xtask reproduce ch2|ch5|ch6|all`, `cargo xtask regress` and `cargo xtask fuzz`.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -9,7 +9,7 @@ use xtask::progress::Progress;
 #[derive(Parser)]
 #[command(
     name = "cargo xtask",
-    about = "Regenerate the thesis benchmarks (chapters 5 and 6), check the stored eigenfrequency curves, fuzz the scene input"
+    about = "Regenerate the thesis benchmarks (chapters 2, 5 and 6), check the stored eigenfrequency curves, fuzz the scene input"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -18,6 +18,7 @@ struct Cli {
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Chapter {
+    Ch2,
     Ch5,
     Ch6,
     All,
@@ -37,7 +38,7 @@ enum FuzzTarget {
 enum Cmd {
     /// Regenerate a chapter's results into OUT/chN (CSV, SVG, report.md).
     Reproduce {
-        /// ch5, ch6 or all.
+        /// ch2, ch5, ch6 or all.
         chapter: Chapter,
         /// Output directory.
         #[arg(long, default_value = "results")]
@@ -149,6 +150,16 @@ fn reproduce(
     pg: &Progress,
 ) -> Result<(), String> {
     let mut summary = vec![];
+    if matches!(ch, Chapter::Ch2 | Chapter::All) {
+        let t = std::time::Instant::now();
+        let rows = xtask::ch2::reproduce(&out.join("ch2"), pg)?;
+        summary.push(format!(
+            "chapter 2 in {:.0} s: {}",
+            t.elapsed().as_secs_f64(),
+            out.join("ch2/report.md").display()
+        ));
+        summary.extend(rows.iter().map(xtask::reproduce6::summary_line));
+    }
     if matches!(ch, Chapter::Ch5 | Chapter::All) {
         let t = std::time::Instant::now();
         let rows = xtask::ch5::reproduce(root, &out.join("ch5"), pg)?;
@@ -178,6 +189,7 @@ fn reproduce(
 
 fn regress(root: &std::path::Path, update: bool, pg: &Progress) -> Result<(), String> {
     let sets = [
+        xtask::regress::recompute_ch2(root, pg)?,
         xtask::regress::recompute_ch5(root, pg)?,
         xtask::regress::recompute_ch6(root, pg)?,
     ];

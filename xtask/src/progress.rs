@@ -72,6 +72,19 @@ impl Bar {
     pub fn inc(&self) {
         self.bar.inc(1);
     }
+    /// Advances by one for a finished item: without a terminal a line names
+    /// it (`what`), so that long runs show progress in logs too.
+    pub fn item_done(&self, what: &str) {
+        self.bar.inc(1);
+        if let Some((label, start)) = &self.line {
+            eprintln!(
+                "{label}: {what} ({}/{}, {:.1} s)",
+                self.bar.position(),
+                self.bar.length().unwrap_or(0),
+                start.elapsed().as_secs_f64()
+            );
+        }
+    }
     /// Finishes the bar (it stays visible; without a terminal a line says
     /// what finished and how long it took).
     pub fn finish(&self) {

@@ -36,6 +36,12 @@ pub fn recompute_ch6(root: &Path, pg: &Progress) -> Result<Recomputed, String> {
     })
 }
 
+/// Recomputes chapter 2's curves (the spin-up beam bent by a tip force, beams
+/// and superelements).
+pub fn recompute_ch2(root: &Path, _pg: &Progress) -> Result<Recomputed, String> {
+    crate::ch2::curves::recompute(root)
+}
+
 /// Recomputes chapter 5's curves.
 pub fn recompute_ch5(root: &Path, pg: &Progress) -> Result<Recomputed, String> {
     ch5::recompute_curves(root, pg)

@@ -1,9 +1,9 @@
-//! The CI regression: the eigenfrequency curves of chapters 5 and 6 (unreduced
+//! The CI regression: the eigenfrequency curves of chapters 2, 5 and 6 (unreduced
 //! and every reduced model) are recomputed and compared with those stored in
 //! `fixtures/curves/` (`cargo xtask regress --update` stores them).
 
 use xtask::progress::Progress;
-use xtask::regress::{check, recompute_ch5, recompute_ch6, RTOL};
+use xtask::regress::{check, recompute_ch2, recompute_ch5, recompute_ch6, RTOL};
 
 /// Asserts that the recomputed curves of `models` models agree with the stored ones.
 fn assert_matches_fixtures(r: &xtask::regress::Recomputed, models: usize) {
@@ -15,6 +15,12 @@ fn assert_matches_fixtures(r: &xtask::regress::Recomputed, models: usize) {
         d.len(),
         d.join("\n")
     );
+}
+
+#[test]
+fn chapter_2_curves_match_the_stored_ones() {
+    let root = xtask::workspace_root();
+    assert_matches_fixtures(&recompute_ch2(&root, &Progress::hidden()).unwrap(), 2);
 }
 
 #[test]

@@ -17,6 +17,22 @@ pub struct Part {
     pub settings: BuildSettings,
 }
 
+impl Part {
+    /// The same part with its boundary nodes swapped: p becomes q and q
+    /// becomes p, with their interfaces (and warping switches). The
+    /// superelement built from it has the reversed element direction of thesis
+    /// Fig. 2.11: its x axis points the other way (R0's first column is
+    /// negated) and its node order in a scene is reversed. `y_axis` is kept,
+    /// so R0's y axis is the same and its z axis flips.
+    pub fn reversed(mut self) -> Self {
+        let s = &mut self.settings;
+        std::mem::swap(&mut s.p, &mut s.q);
+        std::mem::swap(&mut s.interface_p, &mut s.interface_q);
+        std::mem::swap(&mut s.warping_p, &mut s.warping_q);
+        self
+    }
+}
+
 fn plane_x(x: f64, scale: f64) -> NodeSelection {
     NodeSelection::NearPlane {
         point: [x, 0.0, 0.0],
@@ -130,15 +146,29 @@ pub fn box_arm(
     Ok(Part { mesh, settings })
 }
 
+/// Which half of the unbalanced shaft of thesis Fig. 2.13.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShaftHalf {
+    /// The rod along the x axis from x = −`rod_len` to 0 and the first half of
+    /// the cylinder, x from 0 to l/2.
+    First,
+    /// The second half of the cylinder, x from l/2 to l, and the rod from l to
+    /// l + `rod_len`: the first half turned by π about the y axis through the
+    /// shaft's middle (so the cylinder stays at y = +r).
+    Second,
+}
+
 /// Half of the unbalanced rotating shaft of thesis Table 2.2 (rod d1 = 2 mm,
 /// eccentric cylinder d2 = 30 mm of length l = 75 mm with its axis offset by
-/// r = 11 mm): a rod along the x axis from x = −`rod_len` to 0 and the first
-/// half of the cylinder, x from 0 to l/2, centred at y = r. The rod length is
-/// not given in the thesis text; it is a parameter here. The rod's end face is
-/// tied to the cylinder's face by a massless rigid link (the meshes do not
-/// conform there). p is the rod's free end, q the shaft axis at mid-cylinder,
-/// interface q the whole cylinder section there.
+/// r = 11 mm): a rod on the x axis and half of the cylinder, centred at
+/// y = r (see [`ShaftHalf`]). The rod length is not given in the thesis
+/// text; it is a parameter here. The rod's end face is tied to the cylinder's
+/// face by a massless rigid link (the meshes do not conform there). p is the
+/// rod's free end, q the shaft axis at mid-cylinder (x = l/2), interface q
+/// the whole cylinder section there; [`Part::reversed`] gives the part joined
+/// at p instead (thesis Fig. 2.16).
 pub fn unbalanced_shaft_half(
+    half: ShaftHalf,
     rod_len: f64,
     n_section: usize,
     n_rod: usize,
@@ -146,30 +176,43 @@ pub fn unbalanced_shaft_half(
     mat: Material,
 ) -> Result<Part, Error> {
     let (d1, d2, l, r) = (2.0e-3, 3.0e-2, 7.5e-2, 1.1e-2);
-    let rod = Mesh::cylinder_x(-rod_len, [0.0, 0.0], rod_len, d1, 2, n_rod, mat)?;
-    let cyl = Mesh::cylinder_x(0.0, [r, 0.0], 0.5 * l, d2, n_section, n_cyl, mat)?;
+    // x of the rod's free end, of the rod–cylinder face and of the middle
+    let (x_end, x_face, x_mid) = match half {
+        ShaftHalf::First => (-rod_len, 0.0, 0.5 * l),
+        ShaftHalf::Second => (l + rod_len, l, 0.5 * l),
+    };
+    let rod = Mesh::cylinder_x(x_end.min(x_face), [0.0, 0.0], rod_len, d1, 2, n_rod, mat)?;
+    let cyl = Mesh::cylinder_x(
+        x_face.min(x_mid),
+        [r, 0.0],
+        0.5 * l,
+        d2,
+        n_section,
+        n_cyl,
+        mat,
+    )?;
     let mesh = rod.merge(&cyl, 1e-12);
     let s = rod_len + l;
     let h = d2 / n_section as f64;
     let tie = PointMass {
         name: "rod–cylinder tie".into(),
         mass: 0.0,
-        position: [0.0, 0.0, 0.0],
+        position: [x_face, 0.0, 0.0],
         inertia: None,
         nodes: NodeSelection::Intersection(vec![
-            plane_x(0.0, s),
+            plane_x(x_face, s),
             NodeSelection::NearSegment {
-                a: [0.0, 0.0, 0.0],
-                b: [0.0, 0.0, 0.0],
+                a: [x_face, 0.0, 0.0],
+                b: [x_face, 0.0, 0.0],
                 radius: (0.5 * d1).max(0.75 * h) * 1.0001,
             },
         ]),
     };
     let mut settings = BuildSettings::new(
-        [-rod_len, 0.0, 0.0],
-        [0.5 * l, 0.0, 0.0],
-        plane_x(-rod_len, s),
-        plane_x(0.5 * l, s),
+        [x_end, 0.0, 0.0],
+        [x_mid, 0.0, 0.0],
+        plane_x(x_end, s),
+        plane_x(x_mid, s),
     );
     settings.point_masses.push(tie);
     Ok(Part { mesh, settings })

@@ -476,7 +476,15 @@ fn curved_meshes_pass_the_rigid_body_check() {
         g: 8.0e10,
         rho: 7800.0,
     };
-    let part = flexmb_superelement::parts::unbalanced_shaft_half(0.05, 2, 10, 4, steel).unwrap();
+    let part = flexmb_superelement::parts::unbalanced_shaft_half(
+        flexmb_superelement::parts::ShaftHalf::First,
+        0.05,
+        2,
+        10,
+        4,
+        steel,
+    )
+    .unwrap();
     let shaft = part.mesh.assemble("shaft").unwrap();
     let mut worst = vec![(
         "built-in shaft",

@@ -3,6 +3,7 @@
 //! independently of the FE code.
 
 use flexmb_element::Material;
+use flexmb_superelement::parts::ShaftHalf;
 use flexmb_superelement::solid::{hex20_shape, Mesh};
 use flexmb_superelement::{build, parts, RigidBodyProperties};
 use nalgebra::{Matrix3, Vector3};
@@ -232,7 +233,7 @@ fn unbalanced_shaft_rigid_body_properties_match_the_geometry() {
     assert!(analytic.com[1] > 0.01 && analytic.com[1] < R);
     let mut previous: Option<([f64; 3], f64)> = None;
     for ns in [2, 4, 8] {
-        let part = parts::unbalanced_shaft_half(ROD, ns, 10, 4, steel()).unwrap();
+        let part = parts::unbalanced_shaft_half(ShaftHalf::First, ROD, ns, 10, 4, steel()).unwrap();
         let model = part.mesh.assemble("shaft").unwrap();
         let se = build(&model, &part.settings).unwrap();
         assert!((se.data.l0 - (ROD + 0.5 * LC)).abs() < 1e-15);
@@ -309,4 +310,67 @@ fn unbalanced_shaft_rigid_body_properties_match_the_geometry() {
         );
         previous = Some((d_true, area_err));
     }
+}
+
+/// The second half (thesis Fig. 2.13: the first turned by π about the y axis
+/// through the middle) and the first half joined at p (`Part::reversed`,
+/// Fig. 2.16) as superelements. In its own frame (origin p, x̄ towards q) the
+/// second half is the first: the same l0, S̄ and M̄ to rounding, R0 =
+/// diag(−1, 1, −1). The reversed first half has R0 = diag(−1, 1, −1) too, its
+/// centre of mass at l0 − x̄c along x̄ and the same mass and stiffness
+/// invariants (the trace of S̄, the inertia about its centre).
+#[test]
+fn the_second_and_the_reversed_half_are_the_first_seen_from_its_other_end() {
+    let first =
+        build_half(parts::unbalanced_shaft_half(ShaftHalf::First, ROD, 2, 6, 2, steel()).unwrap());
+    let second =
+        build_half(parts::unbalanced_shaft_half(ShaftHalf::Second, ROD, 2, 6, 2, steel()).unwrap());
+    let reversed = build_half(
+        parts::unbalanced_shaft_half(ShaftHalf::First, ROD, 2, 6, 2, steel())
+            .unwrap()
+            .reversed(),
+    );
+    let flip = [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]];
+    let max_abs = |m: &nalgebra::DMatrix<f64>| m.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    for (name, se) in [("second", &second), ("reversed", &reversed)] {
+        assert!((se.l0 - first.l0).abs() < 1e-15, "{name}: l0 {}", se.l0);
+        for i in 0..3 {
+            for k in 0..3 {
+                assert!(
+                    (se.r0[i][k] - flip[i][k]).abs() < 1e-12,
+                    "{name}: R0 {:?}",
+                    se.r0
+                );
+            }
+        }
+    }
+    let (s1, s2) = (first.s_bar_matrix(), second.s_bar_matrix());
+    let (m1, m2) = (first.m_bar_matrix(), second.m_bar_matrix());
+    let ds = max_abs(&(&s2 - &s1)) / max_abs(&s1);
+    let dm = max_abs(&(&m2 - &m1)) / max_abs(&m1);
+    assert!(
+        ds < 1e-9 && dm < 1e-9,
+        "second half: S̄ {ds:.1e}, M̄ {dm:.1e} from the first"
+    );
+    let a = RigidBodyProperties::from_m_bar(&m1, first.l0);
+    let b = RigidBodyProperties::from_m_bar(&reversed.m_bar_matrix(), reversed.l0);
+    assert!((b.mass / a.mass - 1.0).abs() < 1e-12);
+    // seen from the other end: x̄c ↦ l0 − x̄c, ȳ kept (R0's y axis), z̄ ↦ −z̄
+    let expect = [first.l0 - a.com[0], a.com[1], -a.com[2]];
+    for d in 0..3 {
+        assert!(
+            (b.com[d] - expect[d]).abs() < 1e-12 * first.l0,
+            "reversed centre of mass {:?}, expected {expect:?}",
+            b.com
+        );
+    }
+    let trace = |m: &nalgebra::DMatrix<f64>| (0..m.nrows()).map(|i| m[(i, i)]).sum::<f64>();
+    let sr = reversed.s_bar_matrix();
+    assert!((trace(&sr) / trace(&s1) - 1.0).abs() < 1e-9);
+    assert!(a.com[1] > 0.005, "the unbalance is on +y: {:?}", a.com);
+}
+
+fn build_half(part: parts::Part) -> flexmb_element::LinearSuperelement {
+    let model = part.mesh.assemble("shaft").unwrap();
+    build(&model, &part.settings).unwrap().data
 }
