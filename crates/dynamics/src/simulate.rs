@@ -814,9 +814,10 @@ impl Dynamics {
     }
 
     /// q and q̇ in the chart of `mech` (same nodal coordinates and
-    /// deformations as this dynamics' mechanism, perhaps other DOF roles),
-    /// read from the current kinematic state.
-    fn in_chart_of(&self, mech: &Mechanism) -> (Vec<f64>, Vec<f64>) {
+    /// deformations as this dynamics' mechanism, perhaps other DOF roles,
+    /// e.g. the mechanism a run started with before [`ChartSwitch`]es), read
+    /// from the current kinematic state.
+    pub fn in_chart_of(&self, mech: &Mechanism) -> (Vec<f64>, Vec<f64>) {
         let (x, xd, eps, epsd) = (self.kin.x(), self.kin.xd(), self.kin.eps(), self.kin.epsd());
         mech.dofs
             .iter()
@@ -825,6 +826,32 @@ impl Dynamics {
                 Coordinate::Def(j) => (eps[j], epsd[j]),
             })
             .unzip()
+    }
+
+    /// The Jacobian S = ∂q'/∂q of the DOFs q' of `mech` (the same scene in
+    /// another chart, as for [`in_chart_of`](Self::in_chart_of)) with respect
+    /// to this dynamics' DOFs q, at the current configuration: the identity
+    /// in the slots whose coordinate is the same in both, the row of F,q
+    /// (or E,q) of the coordinate `mech` has in a slot where they differ.
+    /// Mode shapes map as S v; a mass or stiffness matrix as S⁻ᵀ M S⁻¹
+    /// (singular where the chart of `mech` is).
+    pub fn chart_jacobian(&mut self, mech: &Mechanism) -> Mat<f64> {
+        let n_q = self.n_q();
+        let own = self.mech.clone();
+        let mut s = Mat::<f64>::identity(n_q, n_q);
+        for (k, (c, c_own)) in mech.dofs.iter().zip(&own.dofs).enumerate() {
+            if c == c_own {
+                continue;
+            }
+            let row = match *c {
+                Coordinate::Node(i) => self.kin.f_xi().row(i).to_owned(),
+                Coordinate::Def(j) => self.kin.e_xi().row(j).to_owned(),
+            };
+            for a in 0..n_q {
+                s[(k, a)] = row[a];
+            }
+        }
+        s
     }
 
     /// Switches every chart that is no longer good at (t, q) (kinematics
