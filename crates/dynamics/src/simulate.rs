@@ -339,6 +339,23 @@ type Q = Vec<f64>;
 /// A state (t, q, q̇) of a run.
 type StateAt = (f64, Q, Q);
 
+/// An integration error `e` with the last evaluation that failed
+/// recoverably (t, message), if there was one, appended: a step-size
+/// underflow then names its cause (e.g. the node whose Euler chart became
+/// singular); not if the error's message has it already (the integrator
+/// gave up on that evaluation). Other errors are returned as they are.
+pub fn with_failure_cause(e: DynamicsError, last_failure: Option<&(f64, String)>) -> DynamicsError {
+    match (last_failure, e) {
+        (Some((t, m)), DynamicsError::Integration { source, message }) if !message.contains(m) => {
+            DynamicsError::Integration {
+                source,
+                message: format!("{message}; the last evaluation that failed (at t = {t:e}): {m}"),
+            }
+        }
+        (_, e) => e,
+    }
+}
+
 /// What a segment of a charted run needs between steps: the chart checks
 /// and the configuration of the last accepted step (the warm start of the
 /// output evaluations).
@@ -376,17 +393,7 @@ impl StepWatch {
     /// An integration error with the last recoverable evaluation failure
     /// when there was one: a step-size underflow names its cause.
     fn with_cause(&self, e: DynamicsError) -> DynamicsError {
-        match (&self.last_failure, e) {
-            (Some((t, m)), DynamicsError::Integration { source, message }) => {
-                DynamicsError::Integration {
-                    source,
-                    message: format!(
-                        "{message}; the last evaluation that failed (at t = {t:e}): {m}"
-                    ),
-                }
-            }
-            (_, e) => e,
-        }
+        with_failure_cause(e, self.last_failure.as_ref())
     }
 
     fn accepted(&mut self, dy: &Dynamics, t: f64, q: &[f64], qd: &[f64]) -> Control {
@@ -672,11 +679,7 @@ impl Dynamics {
                 break;
             }
         }
-        if !Arc::ptr_eq(&self.mech, &start_mech) {
-            let x = self.kin.x().to_vec();
-            self.replace_mechanism(start_mech);
-            self.kin.set_guess(&x);
-        }
+        self.use_chart(&start_mech);
         traj.wall_time = start.elapsed().as_secs_f64();
         Ok(traj)
     }
@@ -859,8 +862,9 @@ impl Dynamics {
     /// position solve starting from the current configuration, and returns
     /// q, q̇ in it. `None` if no chart needs switching. Charts whose
     /// switch would change the coordinate in one of the DOF slots `keep`
-    /// (held by a static solve) stay.
-    pub(crate) fn switch_charts(
+    /// (held by a static solve, or not kept by a reduced model's basis)
+    /// stay. The switches are appended to `log`.
+    pub fn switch_charts(
         &mut self,
         t: f64,
         q: &[f64],
@@ -889,6 +893,18 @@ impl Dynamics {
         self.kin.set_guess(&x);
         self.kinematics_at(t, &q1, None)?;
         Ok(Some((q1, qd1)))
+    }
+
+    /// Puts this dynamics in the chart of `mech` (the same scene with other
+    /// Euler-parameter DOFs, e.g. the mechanism before [`ChartSwitch`]es),
+    /// if it is not in it: rebuilt with its settings, its position solve
+    /// starting from the current configuration.
+    pub fn use_chart(&mut self, mech: &Arc<Mechanism>) {
+        if !Arc::ptr_eq(&self.mech, mech) {
+            let x = self.kin.x().to_vec();
+            self.replace_mechanism(mech.clone());
+            self.kin.set_guess(&x);
+        }
     }
 
     /// Rebuilds this dynamics for `mech` (the same scene with other DOF
