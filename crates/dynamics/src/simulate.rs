@@ -342,11 +342,10 @@ type StateAt = (f64, Q, Q);
 /// An integration error `e` with the last evaluation that failed
 /// recoverably (t, message), if there was one, appended: a step-size
 /// underflow then names its cause (e.g. the node whose Euler chart became
-/// singular); not if the error's message has it already (the integrator
-/// gave up on that evaluation). Other errors are returned as they are.
+/// singular). Other errors are returned as they are.
 pub fn with_failure_cause(e: DynamicsError, last_failure: Option<&(f64, String)>) -> DynamicsError {
     match (last_failure, e) {
-        (Some((t, m)), DynamicsError::Integration { source, message }) if !message.contains(m) => {
+        (Some((t, m)), DynamicsError::Integration { source, message }) => {
             DynamicsError::Integration {
                 source,
                 message: format!("{message}; the last evaluation that failed (at t = {t:e}): {m}"),
