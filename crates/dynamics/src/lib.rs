@@ -66,7 +66,8 @@ pub use linearize::{Linearization, LinearizedAt};
 pub use momentum::Momentum;
 pub use outputs::OutputTable;
 pub use simulate::{
-    integrate_explicit, FirstOrder, Integrator, OutputPoint, SimulationOptions, Trajectory,
+    integrate_explicit, with_failure_cause, FirstOrder, Integrator, OutputPoint, SimulationOptions,
+    Trajectory,
 };
 pub use statics::{StaticOptions, StaticSolution};
 

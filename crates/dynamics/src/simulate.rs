@@ -339,6 +339,22 @@ type Q = Vec<f64>;
 /// A state (t, q, q̇) of a run.
 type StateAt = (f64, Q, Q);
 
+/// An integration error `e` with the last evaluation that failed
+/// recoverably (t, message), if there was one, appended: a step-size
+/// underflow then names its cause (e.g. the node whose Euler chart became
+/// singular). Other errors are returned as they are.
+pub fn with_failure_cause(e: DynamicsError, last_failure: Option<&(f64, String)>) -> DynamicsError {
+    match (last_failure, e) {
+        (Some((t, m)), DynamicsError::Integration { source, message }) => {
+            DynamicsError::Integration {
+                source,
+                message: format!("{message}; the last evaluation that failed (at t = {t:e}): {m}"),
+            }
+        }
+        (_, e) => e,
+    }
+}
+
 /// What a segment of a charted run needs between steps: the chart checks
 /// and the configuration of the last accepted step (the warm start of the
 /// output evaluations).
@@ -376,17 +392,7 @@ impl StepWatch {
     /// An integration error with the last recoverable evaluation failure
     /// when there was one: a step-size underflow names its cause.
     fn with_cause(&self, e: DynamicsError) -> DynamicsError {
-        match (&self.last_failure, e) {
-            (Some((t, m)), DynamicsError::Integration { source, message }) => {
-                DynamicsError::Integration {
-                    source,
-                    message: format!(
-                        "{message}; the last evaluation that failed (at t = {t:e}): {m}"
-                    ),
-                }
-            }
-            (_, e) => e,
-        }
+        with_failure_cause(e, self.last_failure.as_ref())
     }
 
     fn accepted(&mut self, dy: &Dynamics, t: f64, q: &[f64], qd: &[f64]) -> Control {
@@ -672,11 +678,7 @@ impl Dynamics {
                 break;
             }
         }
-        if !Arc::ptr_eq(&self.mech, &start_mech) {
-            let x = self.kin.x().to_vec();
-            self.replace_mechanism(start_mech);
-            self.kin.set_guess(&x);
-        }
+        self.use_chart(&start_mech);
         traj.wall_time = start.elapsed().as_secs_f64();
         Ok(traj)
     }
@@ -814,9 +816,10 @@ impl Dynamics {
     }
 
     /// q and q̇ in the chart of `mech` (same nodal coordinates and
-    /// deformations as this dynamics' mechanism, perhaps other DOF roles),
-    /// read from the current kinematic state.
-    fn in_chart_of(&self, mech: &Mechanism) -> (Vec<f64>, Vec<f64>) {
+    /// deformations as this dynamics' mechanism, perhaps other DOF roles,
+    /// e.g. the mechanism a run started with before [`ChartSwitch`]es), read
+    /// from the current kinematic state.
+    pub fn in_chart_of(&self, mech: &Mechanism) -> (Vec<f64>, Vec<f64>) {
         let (x, xd, eps, epsd) = (self.kin.x(), self.kin.xd(), self.kin.eps(), self.kin.epsd());
         mech.dofs
             .iter()
@@ -827,13 +830,40 @@ impl Dynamics {
             .unzip()
     }
 
+    /// The Jacobian S = ∂q'/∂q of the DOFs q' of `mech` (the same scene in
+    /// another chart, as for [`in_chart_of`](Self::in_chart_of)) with respect
+    /// to this dynamics' DOFs q, at the current configuration: the identity
+    /// in the slots whose coordinate is the same in both, the row of F,q
+    /// (or E,q) of the coordinate `mech` has in a slot where they differ.
+    /// Mode shapes map as S v; a mass or stiffness matrix as S⁻ᵀ M S⁻¹
+    /// (singular where the chart of `mech` is).
+    pub fn chart_jacobian(&mut self, mech: &Mechanism) -> Mat<f64> {
+        let n_q = self.n_q();
+        let own = self.mech.clone();
+        let mut s = Mat::<f64>::identity(n_q, n_q);
+        for (k, (c, c_own)) in mech.dofs.iter().zip(&own.dofs).enumerate() {
+            if c == c_own {
+                continue;
+            }
+            let row = match *c {
+                Coordinate::Node(i) => self.kin.f_xi().row(i).to_owned(),
+                Coordinate::Def(j) => self.kin.e_xi().row(j).to_owned(),
+            };
+            for a in 0..n_q {
+                s[(k, a)] = row[a];
+            }
+        }
+        s
+    }
+
     /// Switches every chart that is no longer good at (t, q) (kinematics
     /// solved there): rebuilds the dynamics in the new chart, with its
     /// position solve starting from the current configuration, and returns
     /// q, q̇ in it. `None` if no chart needs switching. Charts whose
     /// switch would change the coordinate in one of the DOF slots `keep`
-    /// (held by a static solve) stay.
-    pub(crate) fn switch_charts(
+    /// (held by a static solve, or not kept by a reduced model's basis)
+    /// stay. The switches are appended to `log`.
+    pub fn switch_charts(
         &mut self,
         t: f64,
         q: &[f64],
@@ -862,6 +892,18 @@ impl Dynamics {
         self.kin.set_guess(&x);
         self.kinematics_at(t, &q1, None)?;
         Ok(Some((q1, qd1)))
+    }
+
+    /// Puts this dynamics in the chart of `mech` (the same scene with other
+    /// Euler-parameter DOFs, e.g. the mechanism before [`ChartSwitch`]es),
+    /// if it is not in it: rebuilt with its settings, its position solve
+    /// starting from the current configuration.
+    pub fn use_chart(&mut self, mech: &Arc<Mechanism>) {
+        if !Arc::ptr_eq(&self.mech, mech) {
+            let x = self.kin.x().to_vec();
+            self.replace_mechanism(mech.clone());
+            self.kin.set_guess(&x);
+        }
     }
 
     /// Rebuilds this dynamics for `mech` (the same scene with other DOF

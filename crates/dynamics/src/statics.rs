@@ -32,6 +32,15 @@ pub struct StaticOptions {
     /// equilibrium that already carries them, e.g. the previous sweep point).
     /// Held values are always ramped from their values in `q0`.
     pub ramp_loads: bool,
+    /// Ramp the scale of the nodal loads ([`Dynamics::set_load_scale`]) from
+    /// this value to the dynamics' load scale with the continuation
+    /// parameter (gravity is not scaled): a continuation from an equilibrium
+    /// under the nodal loads at this scale, e.g. the previous point of a
+    /// load sweep, in increments that are cut where Newton fails (a full
+    /// step may turn a node through the singular region of its Euler
+    /// chart, which only the switches between increments avoid). `None`:
+    /// the load scale is applied from the start.
+    pub load_scale_from: Option<f64>,
     /// A request to stop, read before every Newton iteration (one atomic
     /// load): when it is set the solve ends with
     /// [`DynamicsError::Interrupted`] (e.g. set by a signal handler).
@@ -47,6 +56,7 @@ impl Default for StaticOptions {
             held: vec![],
             min_increment: 1e-4,
             ramp_loads: true,
+            load_scale_from: None,
             stop: None,
         }
     }
@@ -447,6 +457,21 @@ impl Dynamics {
         q0: &[f64],
         opts: &StaticOptions,
     ) -> Result<StaticSolution, DynamicsError> {
+        let scale = self.load_scale;
+        let solution = self.static_equilibrium_ramped(t, q0, opts, scale);
+        self.load_scale = scale;
+        solution
+    }
+
+    /// [`static_equilibrium`](Self::static_equilibrium) with the nodal loads
+    /// at the scale `scale` at its end.
+    fn static_equilibrium_ramped(
+        &mut self,
+        t: f64,
+        q0: &[f64],
+        opts: &StaticOptions,
+        scale: f64,
+    ) -> Result<StaticSolution, DynamicsError> {
         let n_q = self.mech.n_dof();
         let mut q = q0.to_vec();
         let mut held = vec![false; n_q];
@@ -483,6 +508,9 @@ impl Dynamics {
         while lambda < 1.0 - 1e-15 {
             let target = (lambda + dl).min(1.0);
             self.load_factor = if opts.ramp_loads { target } else { 1.0 };
+            if let Some(s0) = opts.load_scale_from {
+                self.load_scale = s0 + target * (scale - s0);
+            }
             for (k, &(i, v)) in opts.held.iter().enumerate() {
                 let value = held_start[k] + target * (v - held_start[k]);
                 dh[k] = value - q[i];

@@ -127,8 +127,10 @@ pub enum KinematicsError {
     },
     /// The dependent Euler parameter of a node with the other three as DOFs
     /// approaches zero: the parametrization is singular there.
-    #[error("{coordinate} = {value:.3}, the Euler parameter made dependent by the normalization, approaches zero (the node is turned near 180° from where that chart was chosen): simulations and static solves switch charts after each step or load increment (flexmb_model::EulerChart), so one step or increment turned the node too far (in statics: use more load steps); reduced models keep the chart of the reference configuration and cannot describe this rotation: keep the node within ±180° of its reference there, or give the rotation to a hinge deformation")]
+    #[error("node {node}: its Euler parameter {coordinate} = {value:.3}, made dependent by the normalization, approaches zero (the node is turned near 180° from where that chart was chosen, where the chart is singular): simulations, static solves and sweeps switch charts after each step or load increment (flexmb_model::EulerChart), so one step or increment turned the node too far (in statics: use more load steps); a reduced model switches only the charts whose Euler parameters its basis keeps as reduced coordinates (the large coordinates of a modal basis): keep the node's orientation coordinates large, keep the node within ±180° of its reference, or give the rotation to a hinge deformation")]
     EulerParameterDegenerate {
+        /// The node.
+        node: String,
         /// The coordinate.
         coordinate: String,
         /// Its value.
@@ -567,6 +569,7 @@ impl Kinematics {
                 .count();
             if deps.len() == 1 && dofs == 3 && self.x[deps[0]].abs() < 0.05 {
                 return Err(KinematicsError::EulerParameterDegenerate {
+                    node: n.id.clone(),
                     coordinate: self.mech.x_names[deps[0]].clone(),
                     value: self.x[deps[0]],
                 });

@@ -6,14 +6,15 @@
 use crate::{undamped_modes, LinearizeError, Modes};
 use faer::Mat;
 use flexmb_dynamics::{short_number, Dynamics, DynamicsError, StaticOptions};
-use flexmb_model::Mechanism;
+use flexmb_model::{ChartSwitch, Mechanism};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-/// Modes and mass matrices of one worker's block of configurations, with
-/// each configuration's index (the block's first ones if stopped).
-type BlockResult = Result<Vec<(usize, Modes, Mat<f64>)>, LinearizeError>;
+/// Equilibria, modes and mass matrices of one worker's block of
+/// configurations (in the sweep's chart), with each configuration's index
+/// (the block's first ones if stopped).
+type BlockResult = Result<Vec<(usize, Vec<f64>, Modes, Mat<f64>)>, LinearizeError>;
 
 /// What varies along the sweep.
 pub enum SweepParameter {
@@ -48,7 +49,9 @@ pub struct SweepOptions {
 pub struct SweepPoint {
     /// The sweep parameter.
     pub s: f64,
-    /// The equilibrium DOFs.
+    /// The equilibrium DOFs, in the chart of the sweep's mechanism (also
+    /// where the static solve switched the chart of an orientation that
+    /// turned far: every point is in the same DOFs).
     pub q: Vec<f64>,
     /// The generalized forces that hold the held DOFs at their values (the
     /// actuation force along the stroke; [`SweepParameter::Dof`] and
@@ -57,9 +60,10 @@ pub struct SweepPoint {
     pub holding: Vec<f64>,
     /// Undamped eigenfrequencies (Hz).
     pub frequencies_hz: Vec<f64>,
-    /// Mode shapes (if kept).
+    /// Mode shapes (if kept), in the DOFs of [`q`](Self::q).
     pub modes: Option<Mat<f64>>,
-    /// Mass matrix (if the shapes are kept: for MAC with mass weighting).
+    /// Mass matrix (if the shapes are kept: for MAC with mass weighting), in
+    /// the DOFs of [`q`](Self::q).
     pub mass: Option<Mat<f64>>,
 }
 
@@ -124,6 +128,11 @@ pub struct SweepOutcome {
     pub equilibria: usize,
     /// True if the stop request ended the sweep early.
     pub stopped: bool,
+    /// The Euler-parameter charts the static solves switched (nodes that
+    /// turned far, [`flexmb_model::EulerChart`]), each with the index of
+    /// the configuration whose equilibrium switched it. The points' q,
+    /// shapes and masses are still in the chart of the sweep's mechanism.
+    pub chart_switches: Vec<(usize, ChartSwitch)>,
 }
 
 /// True if `stop` is given and set.
@@ -152,10 +161,14 @@ pub fn sweep_until(
     // solve starts there, not at the reference or at a neighbouring block
     let mut xs = Vec::with_capacity(n);
     let mut holding = Vec::with_capacity(n);
+    // the chart of each equilibrium: the static solve switches the chart of
+    // an orientation that turned far, and the continuation goes on in it
+    let mut charts: Vec<Arc<Mechanism>> = Vec::with_capacity(n);
+    let mut chart_switches = vec![];
     // phase 1: equilibria by continuation
     for (i, &s) in opts.values.iter().enumerate() {
         if requested(stop) {
-            return Ok(stopped_early(i));
+            return Ok(stopped_early(i, chart_switches));
         }
         // the first equilibrium ramps the loads; the next ones continue from it
         let mut so = StaticOptions {
@@ -164,7 +177,13 @@ pub fn sweep_until(
             ..Default::default()
         };
         match param {
-            SweepParameter::LoadScale => dy.set_load_scale(s),
+            SweepParameter::LoadScale => {
+                // from the previous point's scale, in increments
+                if i > 0 {
+                    so.load_scale_from = Some(opts.values[i - 1]);
+                }
+                dy.set_load_scale(s);
+            }
             SweepParameter::Dof(k) => so.held = vec![(*k, s)],
             SweepParameter::Path { dofs, path } => {
                 let v = path(s);
@@ -173,12 +192,14 @@ pub fn sweep_until(
         }
         let sol = match dy.static_equilibrium(opts.t, &q, &so) {
             Ok(sol) => sol,
-            Err(DynamicsError::Interrupted) => return Ok(stopped_early(i)),
+            Err(DynamicsError::Interrupted) => return Ok(stopped_early(i, chart_switches)),
             Err(e) => return Err(failed_at(mech, param, opts, i, e.to_string())),
         };
         q = sol.q;
         qs.push(q.clone());
         xs.push(sol.x);
+        charts.push(dy.mechanism().clone());
+        chart_switches.extend(sol.chart_switches.into_iter().map(|c| (i, c)));
         holding.push(sol.reactions);
         progress(i + 1, total);
     }
@@ -200,34 +221,42 @@ pub fn sweep_until(
         .par_chunks(chunk)
         .enumerate()
         .map(|(c, block)| {
-            let mut dy = Dynamics::new(mech.clone());
+            let mut dy = Dynamics::new(charts[c * chunk].clone());
             block
                 .iter()
                 .enumerate()
                 .take_while(|_| !requested(stop))
                 .map(|(j, q)| {
                     let i = c * chunk + j;
+                    if !Arc::ptr_eq(dy.mechanism(), &charts[i]) {
+                        dy = Dynamics::new(charts[i].clone());
+                    }
                     dy.set_load_scale(scale[i]);
                     dy.kinematics_mut().set_guess(&xs[i]);
                     let fail = |m: String| failed_at(mech, param, opts, i, m);
                     let lin = dy
                         .linearize_at_rest(opts.t, q)
                         .map_err(|e| fail(e.to_string()))?;
-                    let modes =
+                    let mut modes =
                         undamped_modes(&lin, opts.modes).map_err(|e| fail(e.to_string()))?;
+                    let (mut q, mut m) = (q.clone(), lin.m);
+                    if !Arc::ptr_eq(&charts[i], mech) {
+                        (q, m) = in_sweep_chart(&mut dy, mech, &mut modes, m, opts.keep_vectors)
+                            .map_err(fail)?;
+                    }
                     let d = done.fetch_add(1, Ordering::Relaxed) + 1;
                     progress(d, total);
-                    Ok((i, modes, lin.m))
+                    Ok((i, q, modes, m))
                 })
                 .collect()
         })
         .collect();
     let mut points = Vec::with_capacity(n);
     for r in results {
-        for (i, modes, m) in r? {
+        for (i, q, modes, m) in r? {
             points.push(SweepPoint {
                 s: opts.values[i],
-                q: qs[i].clone(),
+                q,
                 holding: holding[i].clone(),
                 frequencies_hz: modes.frequencies_hz(),
                 modes: opts.keep_vectors.then(|| modes.vectors.clone()),
@@ -239,14 +268,54 @@ pub fn sweep_until(
         stopped: points.len() < n,
         points,
         equilibria: n,
+        chart_switches,
     })
 }
 
+/// The equilibrium q and, if `with_mass` (the shapes are kept), the mode
+/// shapes and the mass matrix `m` of a configuration linearized by `dy` in another chart than the
+/// sweep's `mech` (an orientation turned far, [`flexmb_model::EulerChart`]),
+/// given in the chart of `mech`: q read from the configuration, the shapes
+/// as S v and the mass as S⁻ᵀ M S⁻¹ with S = ∂q/∂q_dy
+/// ([`Dynamics::chart_jacobian`]), so that every point of a sweep is in
+/// one chart (mass-normalized shapes stay so). The frequencies do not
+/// depend on the chart. An error if `mech`'s chart is singular there and
+/// the mass is wanted.
+fn in_sweep_chart(
+    dy: &mut Dynamics,
+    mech: &Mechanism,
+    modes: &mut Modes,
+    m: Mat<f64>,
+    with_mass: bool,
+) -> Result<(Vec<f64>, Mat<f64>), String> {
+    let (q, _) = dy.in_chart_of(mech);
+    if !with_mass {
+        return Ok((q, m));
+    }
+    let s = dy.chart_jacobian(mech);
+    modes.vectors = &s * &modes.vectors;
+    let mut lu = flexmb_linalg::DenseLu::new(s.nrows());
+    lu.factor(s.as_ref()).map_err(|e| {
+        format!(
+            "the mass matrix cannot be given in the sweep's degrees of freedom, whose \
+             Euler-parameter chart is singular at this configuration ({e}): sweep a range \
+             that stays within 180° of the start orientation"
+        )
+    })?;
+    // S⁻ᵀ M, then (S⁻ᵀ (S⁻ᵀ M)ᵀ)ᵀ = S⁻ᵀ M S⁻¹ (M symmetric)
+    let mut y = m;
+    lu.solve_transpose_in_place(y.as_mut());
+    let mut m_sweep = y.transpose().to_owned();
+    lu.solve_transpose_in_place(m_sweep.as_mut());
+    Ok((q, m_sweep.transpose().to_owned()))
+}
+
 /// The outcome of a sweep stopped after `equilibria` equilibria.
-fn stopped_early(equilibria: usize) -> SweepOutcome {
+fn stopped_early(equilibria: usize, chart_switches: Vec<(usize, ChartSwitch)>) -> SweepOutcome {
     SweepOutcome {
         points: vec![],
         equilibria,
         stopped: true,
+        chart_switches,
     }
 }

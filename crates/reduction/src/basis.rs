@@ -37,6 +37,15 @@ pub trait Basis: Send {
     fn z_reference(&self) -> Vec<f64> {
         vec![0.0; self.n_z()]
     }
+    /// `Some((k, c))` if the full coordinate in slot `slot` is kept as the
+    /// reduced coordinate k: q_slot = c + z_k for every z, and no other full
+    /// coordinate depends on z_k (the large coordinates of a modal basis,
+    /// thesis (5.20)). A reduced model can then switch the Euler-parameter
+    /// chart of a node whose DOFs are kept (the slot's coordinate changes,
+    /// z_k follows it, nothing else moves). `None` by default.
+    fn kept_coordinate(&self, _slot: usize) -> Option<(usize, f64)> {
+        None
+    }
 }
 
 /// The fixed basis G = q0 + V η (thesis (6.16)): G,z = V, G,zz = 0.
@@ -64,6 +73,18 @@ impl Basis for FixedBasis {
         }
         gz.copy_from(&self.v);
         conv.fill(0.0);
+    }
+    /// The column that is the unit vector of `slot`, if the slot's row has
+    /// no other entry.
+    fn kept_coordinate(&self, slot: usize) -> Option<(usize, f64)> {
+        let v = &self.v;
+        if slot >= v.nrows() {
+            return None;
+        }
+        let k = (0..v.ncols()).find(|&k| v[(slot, k)] == 1.0)?;
+        let row_alone = (0..v.ncols()).all(|j| j == k || v[(slot, j)] == 0.0);
+        let col_alone = (0..v.nrows()).all(|i| i == slot || v[(i, k)] == 0.0);
+        (row_alone && col_alone).then_some((k, self.q0[slot]))
     }
 }
 

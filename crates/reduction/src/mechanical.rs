@@ -47,7 +47,7 @@ pub struct ModelTrajectory {
     pub velocities: Vec<Vec<f64>>,
     /// The unreduced response: output times, q, q̇, the configurations x
     /// solved along the run, exact evaluation counts, wall time, whether it
-    /// was stopped, and chart switches (none for a reduced model).
+    /// was stopped, and chart switches.
     pub full: Trajectory,
 }
 
@@ -443,7 +443,7 @@ impl MechanicalModel for ReducedModel {
                 wall_time: tr.wall_time,
                 stopped: tr.stopped,
                 x: tr.x,
-                chart_switches: vec![],
+                chart_switches: tr.chart_switches,
             },
             coordinates: tr.z,
             velocities: tr.zd,

@@ -4,7 +4,7 @@ use crate::{Basis, ReductionError};
 use faer::linalg::solvers::Solve;
 use faer::Mat;
 use flexmb_dynamics::Dynamics;
-use flexmb_model::Mechanism;
+use flexmb_model::{Coordinate, Mechanism};
 use flexmb_ode::{OdeSystem, RhsError};
 use std::sync::Arc;
 
@@ -22,6 +22,8 @@ pub struct ReducedModel {
     mg: Mat<f64>,
     mz: Mat<f64>,
     fz: Mat<f64>,
+    /// The chart checks of a running simulation.
+    watch: ChartWatch,
 }
 
 impl ReducedModel {
@@ -56,6 +58,7 @@ impl ReducedModel {
             mg: Mat::zeros(nq, nz),
             mz: Mat::zeros(nz, nz),
             fz: Mat::zeros(nz, 1),
+            watch: ChartWatch::default(),
             basis,
         })
     }
@@ -462,6 +465,9 @@ pub struct ReducedTrajectory {
     pub wall_time: f64,
     /// True if stopped early by the observer.
     pub stopped: bool,
+    /// The Euler-parameter charts that switched
+    /// ([`simulate`](ReducedModel::simulate)).
+    pub chart_switches: Vec<flexmb_model::ChartSwitch>,
 }
 
 impl ReducedModel {
@@ -469,6 +475,22 @@ impl ReducedModel {
     /// with an explicit integrator (the thesis's choice for reduced models);
     /// `observer(t, z, ż)` may stop the run. The trajectory holds each
     /// output's configuration, solved along the run.
+    ///
+    /// Euler-parameter charts ([`flexmb_model::EulerChart`]) switch as in
+    /// the unreduced [`Dynamics::simulate_with`] where the basis keeps the
+    /// node's DOF parameters as reduced coordinates
+    /// ([`Basis::kept_coordinate`], e.g. the large coordinates of a modal
+    /// basis): the integrator stops after the step where the dependent
+    /// parameter got small, the reduced coordinate of the slot that changes
+    /// takes the value and rate of the parameter it now stands for, nothing
+    /// else moves, and the integration restarts (the counts include the
+    /// restarts). Where the basis mixes a node's Euler parameters into its
+    /// vectors, the reduced coordinates describe the node's orientation only
+    /// in the chart the basis was built in: the basis's configurations in
+    /// x fold back where that chart is singular (λ_dep = 0), no change of
+    /// z continues them, and a motion that turns the node there stops with
+    /// the node named. z and ż are given in the chart the run started with,
+    /// and the model is in that chart again when this returns.
     pub fn simulate(
         &mut self,
         t0: f64,
@@ -485,43 +507,230 @@ impl ReducedModel {
                 zd0.len()
             )));
         }
-        let mut y0 = z0.to_vec();
-        y0.extend_from_slice(zd0);
-        let (mut t, mut z, mut zd, mut x) = (vec![], vec![], vec![], vec![]);
-        let mut failure = None;
+        let t_end = *opts
+            .output_times
+            .last()
+            .ok_or_else(|| ReductionError::Invalid("no output times".into()))?;
+        let start_mech = self.dy.mechanism().clone();
         let start = std::time::Instant::now();
-        let (stats, stopped) = flexmb_dynamics::integrate_explicit(
-            self,
-            opts,
-            t0,
-            &y0,
-            |m: &mut Self, tt: f64, y: &[f64]| {
-                let q = m.full_coordinates(&y[..n]);
-                match m.dy.output_configuration(tt, &q) {
-                    Ok(xt) => x.push(xt),
-                    Err(e) => {
-                        failure = Some(e);
-                        return flexmb_dynamics::Control::Stop;
-                    }
-                }
-                t.push(tt);
-                z.push(y[..n].to_vec());
-                zd.push(y[n..].to_vec());
-                observer(tt, &y[..n], &y[n..])
-            },
-        )?;
-        if let Some(e) = failure {
-            return Err(e.into());
+        let result = self.simulate_charted(t0, z0, zd0, t_end, opts, &start_mech, &mut observer);
+        self.dy.use_chart(&start_mech);
+        self.watch = ChartWatch::default();
+        let mut tr = result?;
+        tr.wall_time = start.elapsed().as_secs_f64();
+        Ok(tr)
+    }
+
+    /// [`simulate`](Self::simulate) in segments between chart switches.
+    #[allow(clippy::too_many_arguments)]
+    fn simulate_charted(
+        &mut self,
+        t0: f64,
+        z0: &[f64],
+        zd0: &[f64],
+        t_end: f64,
+        opts: &flexmb_dynamics::SimulationOptions,
+        start_mech: &Arc<Mechanism>,
+        observer: &mut impl FnMut(f64, &[f64], &[f64]) -> flexmb_dynamics::Control,
+    ) -> Result<ReducedTrajectory, ReductionError> {
+        let n = self.n_z();
+        let mut tr = ReducedTrajectory {
+            t: vec![],
+            z: vec![],
+            zd: vec![],
+            x: vec![],
+            stats: Default::default(),
+            wall_time: 0.0,
+            stopped: false,
+            chart_switches: vec![],
+        };
+        let (mut t_now, mut z, mut zd) = (t0, z0.to_vec(), zd0.to_vec());
+        let mut times = opts.output_times.clone();
+        let mut first = true;
+        loop {
+            self.switch_charts(t_now, &mut z, &mut zd, &mut tr.chart_switches)?;
+            self.watch = ChartWatch::new(self);
+            let seg_opts = flexmb_dynamics::SimulationOptions {
+                output_times: times.clone(),
+                ..opts.clone()
+            };
+            let mut y0 = z.clone();
+            y0.extend_from_slice(&zd);
+            let mut failure = None;
+            let mut observer_stopped = false;
+            let run = flexmb_dynamics::integrate_explicit(
+                self,
+                &seg_opts,
+                t_now,
+                &y0,
+                |m: &mut Self, tt: f64, y: &[f64]| {
+                    let (q, qd) = m.full_state(&y[..n], &y[n..]);
+                    let x = match m.dy.output_configuration(tt, &q) {
+                        Ok(x) => x,
+                        Err(e) => {
+                            failure = Some(e);
+                            return flexmb_dynamics::Control::Stop;
+                        }
+                    };
+                    let (mut zs, mut zds) = (y[..n].to_vec(), y[n..].to_vec());
+                    let now = m.dy.mechanism();
+                    kept_in_chart(&*m.basis, start_mech, now, &x, &qd, &mut zs, &mut zds);
+                    tr.t.push(tt);
+                    tr.x.push(x);
+                    let c = observer(tt, &zs, &zds);
+                    tr.z.push(zs);
+                    tr.zd.push(zds);
+                    observer_stopped |= c == flexmb_dynamics::Control::Stop;
+                    c
+                },
+            );
+            let (stats, stopped) = run.map_err(|e| {
+                flexmb_dynamics::with_failure_cause(e, self.watch.last_failure.as_ref())
+            })?;
+            if let Some(e) = failure {
+                return Err(e.into());
+            }
+            accumulate(&mut tr.stats, &stats, first);
+            first = false;
+            let switch_at = self.watch.switch_at.take();
+            tr.stopped = stopped && (observer_stopped || switch_at.is_none());
+            let Some((ts, zs, zds)) = switch_at else {
+                break;
+            };
+            if tr.stopped || ts >= t_end {
+                break;
+            }
+            (t_now, z, zd) = (ts, zs, zds);
+            times.retain(|&tau| tau > ts);
+            if times.is_empty() {
+                break;
+            }
         }
-        Ok(ReducedTrajectory {
-            t,
-            z,
-            zd,
-            x,
-            stats,
-            wall_time: start.elapsed().as_secs_f64(),
-            stopped,
-        })
+        Ok(tr)
+    }
+
+    /// The full slots whose Euler-parameter chart this model cannot switch:
+    /// those the basis does not keep as a reduced coordinate.
+    fn unswitchable_slots(&self) -> Vec<usize> {
+        (0..self.basis.n_q())
+            .filter(|k| self.basis.kept_coordinate(*k).is_none())
+            .collect()
+    }
+
+    /// Switches the charts that need it at (t, z, ż) and whose slots the
+    /// basis keeps ([`Dynamics::switch_charts`]); z and ż then describe
+    /// the same state in the new chart.
+    fn switch_charts(
+        &mut self,
+        t: f64,
+        z: &mut [f64],
+        zd: &mut [f64],
+        log: &mut Vec<flexmb_model::ChartSwitch>,
+    ) -> Result<(), ReductionError> {
+        if self.dy.mechanism().euler_charts().is_empty() {
+            return Ok(());
+        }
+        let keep = self.unswitchable_slots();
+        let (q, qd) = self.full_state(z, zd);
+        let before = self.dy.mechanism().clone();
+        if self.dy.switch_charts(t, &q, &qd, &keep, log)?.is_some() {
+            let (x, now) = (self.dy.kinematics().x(), self.dy.mechanism());
+            kept_in_chart(&*self.basis, now, &before, x, &qd, z, zd);
+        }
+        Ok(())
+    }
+}
+
+/// z, ż of a state in the chart of `from` (its DOF rates q̇ at the
+/// configuration x) changed into the chart of `to` (the same scene in
+/// another chart): the reduced coordinates that `basis` keeps for the
+/// slots whose coordinate differs take the value and rate of the coordinate
+/// `to` has there; nothing else changes.
+fn kept_in_chart(
+    basis: &dyn Basis,
+    to: &Mechanism,
+    from: &Mechanism,
+    x: &[f64],
+    qd: &[f64],
+    z: &mut [f64],
+    zd: &mut [f64],
+) {
+    for (k, (c, c_from)) in to.dofs.iter().zip(&from.dofs).enumerate() {
+        let (Coordinate::Node(i), true) = (*c, c != c_from) else {
+            continue;
+        };
+        if let Some((j, offset)) = basis.kept_coordinate(k) {
+            z[j] = x[i] - offset;
+            zd[j] = euler_rate(from, i, x, qd);
+        }
+    }
+}
+
+/// The rate of the Euler parameter with nodal-coordinate index `i` in the
+/// chart of `mech` at x with DOF rates q̇: q̇ of its slot if it is a DOF
+/// there, else (the chart's dependent one) from the normalization
+/// Σ λ_m λ̇_m = 0 (thesis (2.9)).
+fn euler_rate(mech: &Mechanism, i: usize, x: &[f64], qd: &[f64]) -> f64 {
+    if let Some(k) = mech.dofs.iter().position(|c| *c == Coordinate::Node(i)) {
+        return qd[k];
+    }
+    mech.euler_charts()
+        .iter()
+        .find(|c| c.dependent == i)
+        .map(|c| -c.dofs.iter().map(|(k, m)| x[*m] * qd[*k]).sum::<f64>() / x[i])
+        .unwrap_or(0.0)
+}
+
+/// Adds the counts of a restarted segment to the run's statistics.
+fn accumulate(total: &mut flexmb_ode::Stats, seg: &flexmb_ode::Stats, first: bool) {
+    if first {
+        *total = seg.clone();
+        return;
+    }
+    total.rhs_evals += seg.rhs_evals;
+    total.steps_accepted += seg.steps_accepted;
+    total.steps_rejected += seg.steps_rejected;
+    total.newton_iterations += seg.newton_iterations;
+    total.newton_failures += seg.newton_failures;
+    total.jacobian_evals += seg.jacobian_evals;
+    total.lu_decompositions += seg.lu_decompositions;
+    if seg.steps_accepted > 0 {
+        total.last_step = seg.last_step;
+        total.min_step = if total.min_step == 0.0 {
+            seg.min_step
+        } else {
+            total.min_step.min(seg.min_step)
+        };
+        total.max_step = total.max_step.max(seg.max_step);
+    }
+}
+
+/// What the integration of a reduced model watches between steps: the
+/// charts it can switch, where one must, and the last evaluation that
+/// failed recoverably (the cause to name if the run fails after it).
+#[derive(Default)]
+struct ChartWatch {
+    /// The charts whose switching slots the basis keeps.
+    charts: Vec<flexmb_model::EulerChart>,
+    /// (t, z, ż) where a chart must switch.
+    switch_at: Option<(f64, Vec<f64>, Vec<f64>)>,
+    last_failure: Option<(f64, String)>,
+}
+
+impl ChartWatch {
+    fn new(m: &ReducedModel) -> Self {
+        let kept = |k: usize| m.basis.kept_coordinate(k).is_some();
+        Self {
+            charts: m
+                .dy
+                .mechanism()
+                .euler_charts()
+                .into_iter()
+                .filter(|c| c.dofs.iter().any(|(k, _)| kept(*k)))
+                .collect(),
+            switch_at: None,
+            last_failure: None,
+        }
     }
 }
 
@@ -532,14 +741,39 @@ impl OdeSystem for ReducedModel {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         let n = self.basis.n_z();
         let (z, zd) = y.split_at(n);
-        self.accelerations(t, z, zd, &mut dy[n..])
-            .map_err(|e| match e {
+        if let Err(e) = self.accelerations(t, z, zd, &mut dy[n..]) {
+            return Err(match e {
                 ReductionError::Dynamics(flexmb_dynamics::DynamicsError::Kinematics { .. }) => {
-                    RhsError::recoverable(e.to_string())
+                    let m = e.to_string();
+                    self.watch.last_failure = Some((t, m.clone()));
+                    RhsError::recoverable(m)
                 }
                 _ => RhsError::new(e.to_string()),
-            })?;
+            });
+        }
         dy[..n].copy_from_slice(zd);
         Ok(())
+    }
+    /// Stops the integration after a step where a chart this model can
+    /// switch needs it ([`ReducedModel::simulate`] switches and restarts).
+    fn step_accepted(&mut self, t: f64, y: &[f64]) -> flexmb_dynamics::Control {
+        if self.watch.charts.is_empty() {
+            return flexmb_dynamics::Control::Continue;
+        }
+        let n = self.basis.n_z();
+        let (z, zd) = y.split_at(n);
+        self.basis
+            .eval(z, zd, &mut self.q, &mut self.gz, &mut self.conv);
+        let q = &self.q;
+        let basis = &self.basis;
+        let needed = self.watch.charts.iter().any(|c| {
+            c.needs_switch(q)
+                .is_some_and(|(slot, _)| basis.kept_coordinate(slot).is_some())
+        });
+        if needed {
+            self.watch.switch_at = Some((t, z.to_vec(), zd.to_vec()));
+            return flexmb_dynamics::Control::Stop;
+        }
+        flexmb_dynamics::Control::Continue
     }
 }
