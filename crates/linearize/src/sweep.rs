@@ -3,7 +3,7 @@
 //! linearization (E.6) and the undamped modes; the linearizations and eigen
 //! analyses run in parallel (rayon), each worker with its own dynamics.
 
-use crate::{undamped_modes, LinearizeError, Modes};
+use crate::{undamped_modes_until, LinearizeError, Modes};
 use faer::Mat;
 use flexmb_dynamics::{short_number, Dynamics, DynamicsError, StaticOptions};
 use flexmb_model::Mechanism;
@@ -132,8 +132,10 @@ fn requested(stop: Option<&Arc<AtomicBool>>) -> bool {
 }
 
 /// [`sweep`] that ends early when `stop` is set: it is read before every
-/// configuration of both phases and by every Newton iteration of the
-/// equilibria ([`StaticOptions::stop`]). A sweep stopped while finding the
+/// configuration of the equilibria and by every Newton iteration
+/// ([`StaticOptions::stop`]), and inside the linearization and the eigen
+/// analysis of each configuration
+/// ([`Dynamics::linearize_at_rest_until`], [`undamped_modes_until`]). A sweep stopped while finding the
 /// equilibria has no modes; one stopped in the eigen analyses returns the
 /// configurations that are done.
 pub fn sweep_until(
@@ -201,25 +203,28 @@ pub fn sweep_until(
         .enumerate()
         .map(|(c, block)| {
             let mut dy = Dynamics::new(mech.clone());
-            block
-                .iter()
-                .enumerate()
-                .take_while(|_| !requested(stop))
-                .map(|(j, q)| {
-                    let i = c * chunk + j;
-                    dy.set_load_scale(scale[i]);
-                    dy.kinematics_mut().set_guess(&xs[i]);
-                    let fail = |m: String| failed_at(mech, param, opts, i, m);
-                    let lin = dy
-                        .linearize_at_rest(opts.t, q)
-                        .map_err(|e| fail(e.to_string()))?;
-                    let modes =
-                        undamped_modes(&lin, opts.modes).map_err(|e| fail(e.to_string()))?;
-                    let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                    progress(d, total);
-                    Ok((i, modes, lin.m))
-                })
-                .collect()
+            let flag = stop.map(|s| s.as_ref());
+            let mut out = Vec::with_capacity(block.len());
+            for (j, q) in block.iter().enumerate() {
+                let i = c * chunk + j;
+                dy.set_load_scale(scale[i]);
+                dy.kinematics_mut().set_guess(&xs[i]);
+                let fail = |m: String| failed_at(mech, param, opts, i, m);
+                let lin = match dy.linearize_at_rest_until(opts.t, q, flag) {
+                    Ok(lin) => lin,
+                    Err(DynamicsError::Interrupted) => break,
+                    Err(e) => return Err(fail(e.to_string())),
+                };
+                let modes = match undamped_modes_until(&lin, opts.modes, flag) {
+                    Ok(modes) => modes,
+                    Err(LinearizeError::Interrupted) => break,
+                    Err(e) => return Err(fail(e.to_string())),
+                };
+                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                progress(d, total);
+                out.push((i, modes, lin.m));
+            }
+            Ok(out)
         })
         .collect();
     let mut points = Vec::with_capacity(n);
