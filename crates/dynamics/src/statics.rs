@@ -494,6 +494,7 @@ impl Dynamics {
         let mut last_good = q.clone();
         let mut last_err = None;
         let mut force_refresh = false;
+        let mut failures = 0;
         // where the tangent was last found singular (q, load factor), to name
         // the unrestrained motion if the solve gives up
         let mut singular_at: Option<(Vec<f64>, f64)> = None;
@@ -716,7 +717,11 @@ impl Dynamics {
                 self.kin.set_guess(&x_good);
                 let _ = self.kin.solve(&q, t);
                 dl *= 0.5;
-                if dl < opts.min_increment {
+                // without ramped loads or held values every increment is the
+                // same problem: one retry with a fresh tangent, no more
+                failures += 1;
+                let ramps = opts.ramp_loads || !opts.held.is_empty();
+                if dl < opts.min_increment || (!ramps && failures > 1) {
                     if let (
                         Some(DynamicsError::SingularTangent {
                             load_factor,

@@ -191,6 +191,16 @@ pub fn sweep_until(
             recent.clear();
             solved = dy.static_equilibrium(opts.t, &q, &so);
         }
+        if i > 0
+            && matches!(param, SweepParameter::LoadScale)
+            && !matches!(solved, Ok(_) | Err(DynamicsError::Interrupted))
+        {
+            // the loads are not ramped from the last equilibrium (it carries
+            // them at its own scale): ramp the scale instead
+            recent.clear();
+            let s_prev = opts.values[i - 1];
+            solved = load_scale_steps(&mut dy, opts.t, &q, s_prev, s, &so, &mut iterations);
+        }
         let sol = match solved {
             Ok(sol) => sol,
             Err(DynamicsError::Interrupted) => return Ok(stopped_early(i, iterations)),
@@ -282,6 +292,53 @@ fn stopped_early(equilibria: usize, iterations: usize) -> SweepOutcome {
         equilibria,
         stopped: true,
         iterations,
+    }
+}
+
+/// Smallest fraction of a load-scale interval that [`load_scale_steps`]
+/// steps by before giving up.
+const MIN_LOAD_SCALE_FRACTION: f64 = 1.0 / 1024.0;
+
+/// The equilibrium at load scale `s` continued from the equilibrium `q` at
+/// `s_prev` in steps of the load scale: half the interval first (the whole
+/// of it has failed), a step that fails is halved, one that converges is
+/// doubled for the next, down to [`MIN_LOAD_SCALE_FRACTION`] of the
+/// interval. (The load increments of `static_equilibrium` do not help here:
+/// a continuation from an equilibrium applies the loads fully from the
+/// start, `StaticOptions::ramp_loads` false.) Adds the Newton iterations of
+/// the intermediate equilibria to `iterations`; leaves the load scale at `s`.
+fn load_scale_steps(
+    dy: &mut Dynamics,
+    t: f64,
+    q: &[f64],
+    s_prev: f64,
+    s: f64,
+    so: &StaticOptions,
+    iterations: &mut usize,
+) -> Result<flexmb_dynamics::StaticSolution, DynamicsError> {
+    let interval = s - s_prev;
+    let (mut from, mut step, mut q) = (s_prev, 0.5 * interval, q.to_vec());
+    loop {
+        let last = (s - from).abs() <= step.abs();
+        let target = if last { s } else { from + step };
+        dy.set_load_scale(target);
+        match dy.static_equilibrium(t, &q, so) {
+            Ok(sol) if last => return Ok(sol),
+            Ok(sol) => {
+                *iterations += sol.iterations;
+                q = sol.q;
+                from = target;
+                step *= 2.0;
+            }
+            Err(DynamicsError::Interrupted) => return Err(DynamicsError::Interrupted),
+            Err(e) => {
+                step *= 0.5;
+                if step.abs() < MIN_LOAD_SCALE_FRACTION * interval.abs() {
+                    dy.set_load_scale(s);
+                    return Err(e);
+                }
+            }
+        }
     }
 }
 
