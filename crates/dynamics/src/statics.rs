@@ -17,6 +17,9 @@ pub struct StaticOptions {
     /// their full values in `load_steps` steps of 1/`load_steps`. A step
     /// whose Newton iteration fails is halved (down to `min_increment`); after
     /// a converged step the increment doubles again, up to 1/`load_steps`.
+    /// Without ramped loads (`ramp_loads` false) and held values every
+    /// increment is the same problem: a failed one is retried once, with a
+    /// fresh tangent.
     pub load_steps: usize,
     /// Newton iterations per increment.
     pub max_iterations: usize,

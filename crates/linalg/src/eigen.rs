@@ -24,7 +24,7 @@
 //! K is positive definite, the O(n³) transformation and full
 //! eigendecomposition are replaced by Krylov–Schur on the shift-invert
 //! operator `L_K⁻¹ M L_K⁻ᵀ` (the same operator, its dominant eigenvalues
-//! only: [`crate::shift_invert`]), polished by subspace iteration and
+//! only: `shift_invert.rs` of this crate), polished by subspace iteration and
 //! Rayleigh–Ritz; only the Cholesky factorizations remain O(n³). Should it
 //! not converge, the full method is used.
 //!
@@ -528,6 +528,69 @@ mod tests {
             EigenError::NotPositiveDefinite {
                 matrix: Some(Member::M)
             }
+        );
+    }
+
+    /// A few pairs of a large pencil come from the partial method: a
+    /// spring–mass chain of order 400 with varying masses (a dense pencil in
+    /// effect: M is diagonal but not a multiple of I), K positive definite.
+    /// The 4 lowest pairs agree with the full method (all 400 pairs) to
+    /// 1e-11 relative, satisfy K v = λ M v and VᵀMV = I; for the uniform chain
+    /// they are the known λⱼ = (4k/m) sin²(jπ/(2(n + 1))). A set stop flag
+    /// ends it with `Interrupted`.
+    #[test]
+    fn a_few_pairs_of_a_large_pencil_come_from_the_partial_method() {
+        let n = 400;
+        assert!(n >= PARTIAL_MIN_DIM && 4 * PARTIAL_MAX_FRACTION <= n);
+        let kk = 2.0e4;
+        let k = Mat::from_fn(n, n, |i, j| {
+            if i == j {
+                2.0 * kk
+            } else if i.abs_diff(j) == 1 {
+                -kk
+            } else {
+                0.0
+            }
+        });
+        for uniform in [true, false] {
+            let mass = |i: usize| {
+                if uniform {
+                    0.3
+                } else {
+                    0.3 + 0.2 * (0.37 * i as f64).sin()
+                }
+            };
+            let m = Mat::from_fn(n, n, |i, j| if i == j { mass(i) } else { 0.0 });
+            let few = generalized_eigen(k.as_ref(), m.as_ref(), 4, Definite::Mass).unwrap();
+            let all = generalized_eigen(k.as_ref(), m.as_ref(), n, Definite::Mass).unwrap();
+            assert_eq!(few.values.len(), 4);
+            for j in 0..4 {
+                let r = few.values[j] / all.values[j] - 1.0;
+                assert!(
+                    r.abs() < 1e-11,
+                    "λ{j}: {} against {}",
+                    few.values[j],
+                    all.values[j]
+                );
+                if uniform {
+                    let s = ((j + 1) as f64 * std::f64::consts::PI / (2.0 * (n + 1) as f64)).sin();
+                    let exact = 4.0 * kk / 0.3 * s * s;
+                    assert!((few.values[j] / exact - 1.0).abs() < 1e-10, "λ{j}");
+                }
+            }
+            let (orth, res) = residuals(&k, &m, &few);
+            assert!(orth < 1e-10 && res < 1e-12, "{orth:e} {res:e}");
+        }
+        let m = Mat::<f64>::identity(n, n);
+        let stop = AtomicBool::new(true);
+        assert_eq!(
+            generalized_eigen_until(k.as_ref(), m.as_ref(), 4, Definite::Mass, Some(&stop))
+                .unwrap_err(),
+            EigenError::Interrupted
+        );
+        stop.store(false, std::sync::atomic::Ordering::Relaxed);
+        assert!(
+            generalized_eigen_until(k.as_ref(), m.as_ref(), 4, Definite::Mass, Some(&stop)).is_ok()
         );
     }
 }

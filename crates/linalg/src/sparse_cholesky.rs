@@ -10,7 +10,7 @@
 //! `y ↦ L⁻¹ P M Pᵀ L⁻ᵀ y`, whose largest eigenvalues are 1/λ of the smallest
 //! λ; two steps of shift-invert subspace iteration with a Rayleigh–Ritz
 //! projection ([`crate::eigen::generalized_eigen`]) then polish the pairs
-//! ([`crate::shift_invert`], which the dense solver uses too).
+//! (`shift_invert.rs`, which the dense solver uses too).
 //!
 //! The factorization is on faer's sparse supernodal Cholesky; errors are typed
 //! ([`CholeskyError`], [`EigenError`]).
@@ -223,7 +223,7 @@ impl CholeskyFactor for SparseCholesky {
 /// The `nev` lowest eigenpairs of K φ = λ M φ with K factorized in `llt` and M
 /// applied by `apply_m` (out = M x). Returns λ ascending and M-orthonormal φ
 /// (Krylov–Schur on the shift-invert operator, then two steps of subspace
-/// iteration: [`crate::shift_invert`]).
+/// iteration: `shift_invert.rs`).
 pub fn lowest_eigenpairs(
     llt: &SparseCholesky,
     apply_m: impl Fn(MatRef<'_, f64>, MatMut<'_, f64>) + Sync,

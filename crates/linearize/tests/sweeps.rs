@@ -238,7 +238,8 @@ fn a_held_sweep_with_gravity_costs_at_most_twice_the_iterations_without() {
 /// configuration finds.
 #[test]
 fn a_load_sweep_in_one_large_step_steps_the_load_scale_in_between() {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenes/flexure_chain_720.ron");
+    let p =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenes/flexure_chain_720.ron");
     let mech = Arc::new(Scene::load(&p).unwrap().build(None).unwrap());
     assert_eq!(mech.n_dof(), 720);
     let opts = |values: Vec<f64>| SweepOptions {
@@ -248,26 +249,30 @@ fn a_load_sweep_in_one_large_step_steps_the_load_scale_in_between() {
         keep_vectors: false,
     };
     let run = |values: Vec<f64>| {
-        sweep_until(&mech, &SweepParameter::LoadScale, &opts(values), &|_, _| {}, None)
+        sweep_until(
+            &mech,
+            &SweepParameter::LoadScale,
+            &opts(values),
+            &|_, _| {},
+            None,
+        )
     };
     let stepped = run(vec![0.0, 1.0]).unwrap_or_else(|e| panic!("{e}"));
     // the equilibrium at scale 1 ramped from the reference configuration
     let direct = run(vec![1.0]).unwrap_or_else(|e| panic!("{e}"));
     let (a, b) = (&stepped.points[1], &direct.points[0]);
-    let dq = a
-        .q
-        .iter()
-        .zip(&b.q)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let dq =
+        a.q.iter()
+            .zip(&b.q)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     assert!(dq < 1e-8, "the equilibria differ by {dq:e}");
     for (fa, fb) in a.frequencies_hz.iter().zip(&b.frequencies_hz) {
         assert!((fa / fb - 1.0).abs() < 1e-8, "{fa} Hz against {fb} Hz");
     }
     // the loads move the chain: the equilibrium is not the unloaded one
-    let d0 = a
-        .q
-        .iter()
-        .zip(&stepped.points[0].q)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let d0 =
+        a.q.iter()
+            .zip(&stepped.points[0].q)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     assert!(d0 > 1e-4, "{d0}");
 }
