@@ -528,10 +528,13 @@ fn an_interrupted_sweep_of_a_large_model_stops_inside_the_eigen_analysis() {
 /// signal is forced out with the signal's code, writing nothing. The
 /// generalized-α integration of the 1440-DOF flexure chain: one step attempt
 /// (its tangent of the full model) takes seconds with no check inside, so
-/// SIGINT 12 s after the summary (the equilibrium before the time
-/// integration takes about 5 s) comes in one of them. (A sweep of this model
-/// was the trigger before its linearizations and eigen analyses had checks
-/// inside: see the test above.)
+/// SIGINT 12 s after the summary comes in one of them, unless the set-up
+/// before the time integration (about 5 s alone, more on a loaded machine)
+/// is still running (it exits at once, nothing partial) or the signal comes
+/// just before a step's check (a clean stop): then again with a later
+/// signal, at most three times. (A sweep of this model was the trigger
+/// before its linearizations and eigen analyses had checks inside: see the
+/// test above.)
 #[test]
 fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
     let dir = temp_dir("backstop");
@@ -546,17 +549,26 @@ fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
         "genalpha",
     ];
     let out = dir.join("simulation");
-    let mut child = start(&args, &out);
-    let _stdout = wait_until_computing(&mut child, Duration::from_secs(12));
-    send(&child, "INT");
-    // the grace time, then teardown
-    let (status, took, err) = wait_for_exit(&mut child, Duration::from_secs(3));
-    assert_eq!(status.code(), Some(130), "{err}");
-    assert!(
-        err.contains("reached no point to stop at within 1 s; nothing written"),
-        "{err}"
-    );
-    assert!(took >= Duration::from_secs(1), "{took:?}: {err}");
-    assert!(!out.join("outputs.csv").exists(), "{err}");
-    let _ = std::fs::remove_dir_all(&dir);
+    let mut tries = vec![];
+    for delay in [12, 20, 30] {
+        let _ = std::fs::remove_dir_all(&out);
+        let mut child = start(&args, &out);
+        let _stdout = wait_until_computing(&mut child, Duration::from_secs(delay));
+        send(&child, "INT");
+        // the grace time, then teardown
+        let (status, took, err) = wait_for_exit(&mut child, Duration::from_secs(3));
+        assert_eq!(status.code(), Some(130), "{err}");
+        if err.contains("reached no point to stop at within 1 s; nothing written") {
+            assert!(took >= Duration::from_secs(1), "{took:?}: {err}");
+            assert!(!out.join("outputs.csv").exists(), "{err}");
+            let _ = std::fs::remove_dir_all(&dir);
+            return;
+        }
+        assert!(
+            err.contains("nothing partial to write") || err.contains("partial results written"),
+            "{err}"
+        );
+        tries.push(format!("{delay} s: {}", err.trim()));
+    }
+    panic!("no signal came inside a step: {tries:#?}");
 }
