@@ -488,13 +488,25 @@ fn an_interrupted_sweep_of_a_large_model_stops_inside_the_eigen_analysis() {
         "2",
     ];
     let out = dir.join("sweep");
-    let mut child = start(&args, &out);
-    let _stdout = wait_until_computing(&mut child, Duration::from_secs(10));
-    send(&child, "INT");
-    let (status, took, err) = wait_for_exit(&mut child, Duration::from_secs(3));
-    assert_eq!(status.code(), Some(130), "{err}");
-    let stop_ms = reported_stop_ms(&err);
-    assert!(stop_ms < CHAIN_STOP_WITHIN_MS, "{err}");
+    // on a loaded machine the equilibria can take longer than 10 s: then
+    // again with a later signal (the stop there is checked too)
+    let mut found = None;
+    for delay in [10, 20, 30] {
+        let _ = std::fs::remove_dir_all(&out);
+        let mut child = start(&args, &out);
+        let _stdout = wait_until_computing(&mut child, Duration::from_secs(delay));
+        send(&child, "INT");
+        let (status, took, err) = wait_for_exit(&mut child, Duration::from_secs(3));
+        assert_eq!(status.code(), Some(130), "{err}");
+        let stop_ms = reported_stop_ms(&err);
+        assert!(stop_ms < CHAIN_STOP_WITHIN_MS, "{err}");
+        if err.contains("nothing written: stopped while finding the equilibria") {
+            continue;
+        }
+        found = Some((took, err, stop_ms));
+        break;
+    }
+    let (took, err, stop_ms) = found.expect("the eigen analyses were not reached in 30 s");
     let (_, done) = err
         .split_once("partial results written: ")
         .unwrap_or_else(|| panic!("not stopped in the eigen analyses: {err}"));
