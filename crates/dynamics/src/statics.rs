@@ -17,6 +17,9 @@ pub struct StaticOptions {
     /// their full values in `load_steps` steps of 1/`load_steps`. A step
     /// whose Newton iteration fails is halved (down to `min_increment`); after
     /// a converged step the increment doubles again, up to 1/`load_steps`.
+    /// Without ramped loads (`ramp_loads` false, no `load_scale_from`) and
+    /// held values every increment is the same problem: a failed one is
+    /// retried once, with a fresh tangent.
     pub load_steps: usize,
     /// Newton iterations per increment.
     pub max_iterations: usize,
@@ -41,8 +44,9 @@ pub struct StaticOptions {
     /// chart, which only the switches between increments avoid). `None`:
     /// the load scale is applied from the start.
     pub load_scale_from: Option<f64>,
-    /// A request to stop, read before every Newton iteration (one atomic
-    /// load): when it is set the solve ends with
+    /// A request to stop, read before every Newton iteration and inside the
+    /// assembly of a tangent and before its factorization (one atomic load
+    /// each): when it is set the solve ends with
     /// [`DynamicsError::Interrupted`] (e.g. set by a signal handler).
     pub stop: Option<Arc<AtomicBool>>,
 }
@@ -137,7 +141,23 @@ impl Dynamics {
         t: f64,
         q: &[f64],
     ) -> Result<(Vec<f64>, Mat<f64>), DynamicsError> {
+        self.static_tangent_until(t, q, None)
+    }
+
+    /// [`static_tangent`](Self::static_tangent) that ends with
+    /// [`DynamicsError::Interrupted`] when `stop` is set, read after the
+    /// position solve and inside the geometric stiffness
+    /// ([`flexmb_kinematics::Kinematics::second_order_contraction_until`]).
+    fn static_tangent_until(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        stop: Option<&AtomicBool>,
+    ) -> Result<(Vec<f64>, Mat<f64>), DynamicsError> {
         self.kinematics_at(t, q, None)?;
+        if crate::simulate::stop_requested(stop) {
+            return Err(DynamicsError::Interrupted);
+        }
         self.forces(t, false);
         self.w.copy_from_slice(&self.f);
         self.generalized_force();
@@ -145,7 +165,10 @@ impl Dynamics {
         let k = self.structural_stiffness();
         let neg_f: Vec<f64> = self.f.iter().map(|v| -v).collect();
         let sigma = self.sigma.clone();
-        let mut tangent = self.kin.second_order_contraction(&neg_f, &sigma);
+        let mut tangent = self
+            .kin
+            .second_order_contraction_until(&neg_f, &sigma, stop)
+            .ok_or(DynamicsError::Interrupted)?;
         tangent += &k;
         let l = self.load_stiffness(t);
         tangent -= &l;
@@ -331,7 +354,9 @@ impl Dynamics {
     }
 
     /// The tangent at q, factorized over the free DOFs and kept for chord
-    /// steps; returns the out-of-balance at q.
+    /// steps; returns the out-of-balance at q. A set `stop` ends it with
+    /// [`DynamicsError::Interrupted`] inside the assembly and before the
+    /// factorization.
     fn refresh_static_factor(
         &mut self,
         t: f64,
@@ -339,9 +364,13 @@ impl Dynamics {
         free: &[usize],
         held: &[(usize, f64)],
         load_factor: f64,
+        stop: Option<&AtomicBool>,
     ) -> Result<Vec<f64>, DynamicsError> {
         self.static_factor = None;
-        let (g, tan) = self.static_tangent(t, q)?;
+        let (g, tan) = self.static_tangent_until(t, q, stop)?;
+        if crate::simulate::stop_requested(stop) {
+            return Err(DynamicsError::Interrupted);
+        }
         let tf = Mat::from_fn(free.len(), free.len(), |a, b| tan[(free[a], free[b])]);
         let mut lu = DenseLu::default();
         if let Err(source) = lu.factor(tf.as_ref()) {
@@ -493,6 +522,7 @@ impl Dynamics {
         let mut last_good = q.clone();
         let mut last_err = None;
         let mut force_refresh = false;
+        let mut failures = 0;
         // where the tangent was last found singular (q, load factor), to name
         // the unrestrained motion if the solve gives up
         let mut singular_at: Option<(Vec<f64>, f64)> = None;
@@ -522,7 +552,14 @@ impl Dynamics {
                     q_start[i] -= dh[k];
                 }
                 if self
-                    .refresh_static_factor(t, &q_start, &free, &opts.held, target)
+                    .refresh_static_factor(
+                        t,
+                        &q_start,
+                        &free,
+                        &opts.held,
+                        target,
+                        opts.stop.as_deref(),
+                    )
                     .is_ok()
                 {
                     self.predict_free(&mut q, &free, &dh);
@@ -554,12 +591,23 @@ impl Dynamics {
                 let refreshed =
                     force_refresh || self.static_factor.as_ref().is_none_or(|f| f.free != free);
                 let evaluated = if refreshed {
-                    self.refresh_static_factor(t, &q, &free, &opts.held, target)
+                    self.refresh_static_factor(
+                        t,
+                        &q,
+                        &free,
+                        &opts.held,
+                        target,
+                        opts.stop.as_deref(),
+                    )
                 } else {
                     self.static_residual(t, &q)
                 };
                 let g = match evaluated {
                     Ok(g) => g,
+                    Err(DynamicsError::Interrupted) => {
+                        self.load_factor = 1.0;
+                        return Err(DynamicsError::Interrupted);
+                    }
                     Err(e) => {
                         if matches!(e, DynamicsError::SingularTangent { .. }) {
                             singular_at = Some((q.clone(), self.load_factor));
@@ -700,7 +748,13 @@ impl Dynamics {
                 self.kin.set_guess(&x_good);
                 let _ = self.kin.solve(&q, t);
                 dl *= 0.5;
-                if dl < opts.min_increment {
+                // without ramped loads, load scale or held values every
+                // increment is the same problem: one retry with a fresh
+                // tangent, no more
+                failures += 1;
+                let ramps =
+                    opts.ramp_loads || !opts.held.is_empty() || opts.load_scale_from.is_some();
+                if dl < opts.min_increment || (!ramps && failures > 1) {
                     if let (
                         Some(DynamicsError::SingularTangent {
                             load_factor,

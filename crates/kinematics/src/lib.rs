@@ -1560,6 +1560,29 @@ impl Kinematics {
     /// G = F,qᵀ (Σ_dep σⱼ Dⱼ,xx − Σ_rows μᵣ Dᵣ,xx) F,q with Jᵀμ = (w + D,xᵀσ_dep)_dep.
     /// Call after [`first_order`](Self::first_order).
     pub fn second_order_contraction(&mut self, w: &[f64], sigma: &[f64]) -> Mat<f64> {
+        let hf = self.weighted_hessian_times_f(w, sigma);
+        self.contract_with_f(&hf)
+    }
+
+    /// [`second_order_contraction`](Self::second_order_contraction) that
+    /// returns `None` if `stop` is set after the element loop, before the
+    /// product with F,qᵀ (each about half of the cost for a large model).
+    pub fn second_order_contraction_until(
+        &mut self,
+        w: &[f64],
+        sigma: &[f64],
+        stop: Option<&std::sync::atomic::AtomicBool>,
+    ) -> Option<Mat<f64>> {
+        let hf = self.weighted_hessian_times_f(w, sigma);
+        if stop.is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed)) {
+            return None;
+        }
+        Some(self.contract_with_f(&hf))
+    }
+
+    /// HF = Σ_e scatter(H_e F_e) of
+    /// [`second_order_contraction`](Self::second_order_contraction) (n_x × n_q).
+    fn weighted_hessian_times_f(&mut self, w: &[f64], sigma: &[f64]) -> Mat<f64> {
         self.ensure_lu_at_x();
         self.ensure_first_order();
         let mech = self.mech.clone();
@@ -1639,21 +1662,33 @@ impl Kinematics {
                 }
             }
         }
+        hf
+    }
+
+    /// G = F,qᵀ HF, symmetric, for HF of
+    /// [`weighted_hessian_times_f`](Self::weighted_hessian_times_f).
+    fn contract_with_f(&self, hf: &Mat<f64>) -> Mat<f64> {
+        let n_q = self.n_q;
+        // G is symmetric (each H_e is): only its lower triangle is computed,
+        // half the cost of the dense product (the bulk of a linearization of
+        // a large model: 0.28 s of 0.46 s for the 1440-DOF flexure chain),
+        // then mirrored
+        use faer::linalg::matmul::triangular::{matmul, BlockStructure};
         let mut g = Mat::<f64>::zeros(n_q, n_q);
-        faer::linalg::matmul::matmul(
+        matmul(
             g.as_mut(),
+            BlockStructure::TriangularLower,
             faer::Accum::Replace,
             self.f.subcols(0, n_q).transpose(),
+            BlockStructure::Rectangular,
             hf.as_ref(),
+            BlockStructure::Rectangular,
             1.0,
             faer::Par::Seq,
         );
-        // symmetric by construction up to rounding
-        for r in 0..n_q {
-            for c in r + 1..n_q {
-                let v = 0.5 * (g[(r, c)] + g[(c, r)]);
-                g[(r, c)] = v;
-                g[(c, r)] = v;
+        for c in 0..n_q {
+            for r in c + 1..n_q {
+                g[(c, r)] = g[(r, c)];
             }
         }
         g

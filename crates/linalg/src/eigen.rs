@@ -19,10 +19,30 @@
 //! eigenvalues are finally computed as Rayleigh quotients `vᵀKv / vᵀMv` and
 //! the vectors M-normalized, `VᵀMV = I`.
 //!
+//! When only a few of the lowest pairs of a large pencil are asked for
+//! (n ≥ [`PARTIAL_MIN_DIM`], at most n/[`PARTIAL_MAX_FRACTION`] pairs) and
+//! K is positive definite, the O(n³) transformation and full
+//! eigendecomposition are replaced by Krylov–Schur on the shift-invert
+//! operator `L_K⁻¹ M L_K⁻ᵀ` (the same operator, its dominant eigenvalues
+//! only: `shift_invert.rs` of this crate), polished by subspace iteration and
+//! Rayleigh–Ritz; only the Cholesky factorizations remain O(n³). Should it
+//! not converge, the full method is used.
+//!
 //! Both matrices are symmetrized, `½(A + Aᵀ)`, before use.
 
+use crate::shift_invert::{check_stop, lowest_pairs, CholeskyFactor};
 use faer::linalg::triangular_solve as tri;
-use faer::{Mat, MatRef, Par, Side};
+use faer::{Mat, MatMut, MatRef, Par, Side};
+use std::sync::atomic::AtomicBool;
+
+/// The smallest dimension for which [`generalized_eigen`] computes only the
+/// pairs asked for (Krylov–Schur) rather than all of them. (The 1440-DOF
+/// flexure chain: 2 modes in 0.1 s instead of 0.95 s.)
+pub const PARTIAL_MIN_DIM: usize = 200;
+
+/// [`generalized_eigen`] computes only the pairs asked for when they are at
+/// most 1/`PARTIAL_MAX_FRACTION` of the dimension.
+pub const PARTIAL_MAX_FRACTION: usize = 8;
 
 /// Which member of the pencil (K, M) must be positive definite.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -118,6 +138,9 @@ pub enum EigenError {
         /// The eigenvalue.
         value: f64,
     },
+    /// The stop request of [`generalized_eigen_until`] was set.
+    #[error("the eigen analysis was stopped on request")]
+    Interrupted,
 }
 
 /// Eigenvalues, ascending, and M-normalized eigenvectors as columns.
@@ -181,6 +204,24 @@ fn congruence(l: &Mat<f64>, a: &Mat<f64>) -> Mat<f64> {
     sym(bt.as_ref())
 }
 
+/// A dense lower Cholesky factor as the shift-invert operator of
+/// [`crate::shift_invert`] (no permutation).
+struct DenseFactor<'a>(&'a Mat<f64>);
+
+impl CholeskyFactor for DenseFactor<'_> {
+    fn n(&self) -> usize {
+        self.0.nrows()
+    }
+    fn forward(&self, b: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+        out.copy_from(b);
+        tri::solve_lower_triangular_in_place(self.0.as_ref(), out, Par::Seq);
+    }
+    fn backward(&self, y: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+        out.copy_from(y);
+        tri::solve_upper_triangular_in_place(self.0.transpose(), out, Par::Seq);
+    }
+}
+
 /// The `count` lowest eigenpairs (all when `count` ≥ n) of the symmetric
 /// pencil `K v = λ M v`, λ ascending, `VᵀMV = I`; `definite` says which
 /// member must be positive definite. See the [module documentation](self)
@@ -190,6 +231,21 @@ pub fn generalized_eigen(
     m: MatRef<'_, f64>,
     count: usize,
     definite: Definite,
+) -> Result<GeneralizedEigen, EigenError> {
+    generalized_eigen_until(k, m, count, definite, None)
+}
+
+/// [`generalized_eigen`] that ends with [`EigenError::Interrupted`] when
+/// `stop` is set: it is read between the factorizations and the steps of the
+/// partial method (none of them longer than a Cholesky factorization); the
+/// full method, for small problems or many pairs, reads it before and after
+/// its eigendecomposition.
+pub fn generalized_eigen_until(
+    k: MatRef<'_, f64>,
+    m: MatRef<'_, f64>,
+    count: usize,
+    definite: Definite,
+    stop: Option<&AtomicBool>,
 ) -> Result<GeneralizedEigen, EigenError> {
     let n = check_dims(k, m)?;
     check_finite(k, Member::K)?;
@@ -201,6 +257,7 @@ pub fn generalized_eigen(
             vectors: Mat::zeros(0, 0),
         });
     }
+    check_stop(stop)?;
     let (ks, ms) = (sym(k), sym(m));
     let mut lm = None;
     if definite == Definite::Mass {
@@ -208,7 +265,30 @@ pub fn generalized_eigen(
             matrix: Some(Member::M),
         })?);
     }
-    let y = match cholesky(&ks) {
+    check_stop(stop)?;
+    let lk = cholesky(&ks);
+    check_stop(stop)?;
+    if let Some(l) = &lk {
+        if n >= PARTIAL_MIN_DIM && count * PARTIAL_MAX_FRACTION <= n {
+            let apply_m = |x: MatRef<'_, f64>, mut out: MatMut<'_, f64>| {
+                faer::linalg::matmul::matmul(
+                    out.as_mut(),
+                    faer::Accum::Replace,
+                    ms.as_ref(),
+                    x,
+                    1.0,
+                    Par::Seq,
+                )
+            };
+            match lowest_pairs(&DenseFactor(l), apply_m, count, stop) {
+                Ok((values, vectors)) => return Ok(GeneralizedEigen { values, vectors }),
+                Err(EigenError::Interrupted) => return Err(EigenError::Interrupted),
+                // not converged: the full method
+                Err(_) => {}
+            }
+        }
+    }
+    let y = match lk {
         Some(l) => {
             // K = Lk Lkᵀ: Lk⁻¹ M Lk⁻ᵀ y = (1/λ) y, v = Lk⁻ᵀ y; largest 1/λ first
             let (s, u) = standard_eigen(congruence(&l, &ms))?;
@@ -228,6 +308,7 @@ pub fn generalized_eigen(
             back_substitute(&l, Mat::from_fn(n, count, |i, j| u[(i, order[j])]))
         }
     };
+    check_stop(stop)?;
     // Rayleigh quotients and M-normalization
     let kv = &ks * &y;
     let mv = &ms * &y;
@@ -447,6 +528,69 @@ mod tests {
             EigenError::NotPositiveDefinite {
                 matrix: Some(Member::M)
             }
+        );
+    }
+
+    /// A few pairs of a large pencil come from the partial method: a
+    /// spring–mass chain of order 400 with varying masses (a dense pencil in
+    /// effect: M is diagonal but not a multiple of I), K positive definite.
+    /// The 4 lowest pairs agree with the full method (all 400 pairs) to
+    /// 1e-11 relative, satisfy K v = λ M v and VᵀMV = I; for the uniform chain
+    /// they are the known λⱼ = (4k/m) sin²(jπ/(2(n + 1))). A set stop flag
+    /// ends it with `Interrupted`.
+    #[test]
+    fn a_few_pairs_of_a_large_pencil_come_from_the_partial_method() {
+        // large enough for the partial method, 4 pairs few enough
+        let n = 2 * PARTIAL_MIN_DIM;
+        let kk = 2.0e4;
+        let k = Mat::from_fn(n, n, |i, j| {
+            if i == j {
+                2.0 * kk
+            } else if i.abs_diff(j) == 1 {
+                -kk
+            } else {
+                0.0
+            }
+        });
+        for uniform in [true, false] {
+            let mass = |i: usize| {
+                if uniform {
+                    0.3
+                } else {
+                    0.3 + 0.2 * (0.37 * i as f64).sin()
+                }
+            };
+            let m = Mat::from_fn(n, n, |i, j| if i == j { mass(i) } else { 0.0 });
+            let few = generalized_eigen(k.as_ref(), m.as_ref(), 4, Definite::Mass).unwrap();
+            let all = generalized_eigen(k.as_ref(), m.as_ref(), n, Definite::Mass).unwrap();
+            assert_eq!(few.values.len(), 4);
+            for j in 0..4 {
+                let r = few.values[j] / all.values[j] - 1.0;
+                assert!(
+                    r.abs() < 1e-11,
+                    "λ{j}: {} against {}",
+                    few.values[j],
+                    all.values[j]
+                );
+                if uniform {
+                    let s = ((j + 1) as f64 * std::f64::consts::PI / (2.0 * (n + 1) as f64)).sin();
+                    let exact = 4.0 * kk / 0.3 * s * s;
+                    assert!((few.values[j] / exact - 1.0).abs() < 1e-10, "λ{j}");
+                }
+            }
+            let (orth, res) = residuals(&k, &m, &few);
+            assert!(orth < 1e-10 && res < 1e-12, "{orth:e} {res:e}");
+        }
+        let m = Mat::<f64>::identity(n, n);
+        let stop = AtomicBool::new(true);
+        assert_eq!(
+            generalized_eigen_until(k.as_ref(), m.as_ref(), 4, Definite::Mass, Some(&stop))
+                .unwrap_err(),
+            EigenError::Interrupted
+        );
+        stop.store(false, std::sync::atomic::Ordering::Relaxed);
+        assert!(
+            generalized_eigen_until(k.as_ref(), m.as_ref(), 4, Definite::Mass, Some(&stop)).is_ok()
         );
     }
 }

@@ -13,7 +13,9 @@
 //!   mass matrix of the nodal equations of motion).
 //! - [`eigen`]: the dense generalized symmetric-definite eigensolver
 //!   `K v = λ M v` (Cholesky of K or M, transformation, `self_adjoint_eigen`,
-//!   back-substitution, Rayleigh quotients; modes, buckling, Rayleigh–Ritz).
+//!   back-substitution, Rayleigh quotients; modes, buckling, Rayleigh–Ritz),
+//!   with only the pairs asked for computed (Krylov–Schur) for a few modes of
+//!   a large model.
 //! - [`sparse_cholesky`]: a supernodal sparse Cholesky factorization and, with
 //!   it as a shift-invert operator, the lowest eigenpairs of a large sparse
 //!   pencil (Craig–Bampton reduction of solid models).
@@ -24,12 +26,14 @@
 
 pub mod eigen;
 pub mod lu;
+mod shift_invert;
 pub mod skyline;
 pub mod sparse_cholesky;
 pub mod svd;
 
 pub use eigen::{
-    generalized_eigen, generalized_eigenvalues, Definite, EigenError, GeneralizedEigen, Member,
+    generalized_eigen, generalized_eigen_until, generalized_eigenvalues, Definite, EigenError,
+    GeneralizedEigen, Member,
 };
 pub use lu::{DenseLu, LuError, SINGULAR_PIVOT_RATIO};
 pub use sparse_cholesky::{lowest_eigenpairs, CholeskyError, SparseCholesky};

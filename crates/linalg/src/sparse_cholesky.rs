@@ -9,19 +9,17 @@
 //! Krylov–Schur `partial_self_adjoint_eigen` on the operator
 //! `y ↦ L⁻¹ P M Pᵀ L⁻ᵀ y`, whose largest eigenvalues are 1/λ of the smallest
 //! λ; two steps of shift-invert subspace iteration with a Rayleigh–Ritz
-//! projection ([`crate::eigen::generalized_eigen`]) then polish the pairs.
+//! projection ([`crate::eigen::generalized_eigen`]) then polish the pairs
+//! (`shift_invert.rs`, which the dense solver uses too).
 //!
 //! The factorization is on faer's sparse supernodal Cholesky; errors are typed
 //! ([`CholeskyError`], [`EigenError`]).
 
-use crate::eigen::{generalized_eigen, Definite, EigenError};
+use crate::eigen::EigenError;
+use crate::shift_invert::{lowest_pairs, CholeskyFactor};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltParams;
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
-use faer::matrix_free::eigen::{
-    partial_self_adjoint_eigen, partial_self_adjoint_eigen_scratch, PartialEigenParams,
-};
-use faer::matrix_free::LinOp;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, supernodal::SupernodalLltRef, CholeskySymbolicParams,
     SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
@@ -199,141 +197,39 @@ impl SparseCholesky {
     }
 }
 
-/// The shift-invert operator y ↦ L⁻¹ P M Pᵀ L⁻ᵀ y of the pencil (K, M) with
-/// K = Pᵀ L Lᵀ P; its largest eigenvalues are 1/λ for the smallest λ.
-struct ShiftInvert<'a, F: Fn(MatRef<'_, f64>, MatMut<'_, f64>) + Sync> {
-    llt: &'a SparseCholesky,
-    apply_m: F,
-}
-
-impl<F: Fn(MatRef<'_, f64>, MatMut<'_, f64>) + Sync> std::fmt::Debug for ShiftInvert<'_, F> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "ShiftInvert(n = {})", self.llt.n)
+impl CholeskyFactor for SparseCholesky {
+    fn n(&self) -> usize {
+        self.n
     }
-}
-
-impl<F: Fn(MatRef<'_, f64>, MatMut<'_, f64>) + Sync> LinOp<f64> for ShiftInvert<'_, F> {
-    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
-        StackReq::EMPTY
+    fn forward(&self, b: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+        self.permute_in(b, out.as_mut());
+        let mut buf = self.scratch(b.ncols());
+        self.supernodal()
+            .l_solve_with_conj(Conj::No, out, Par::Seq, MemStack::new(&mut buf));
     }
-    fn nrows(&self) -> usize {
-        self.llt.n
-    }
-    fn ncols(&self) -> usize {
-        self.llt.n
-    }
-    fn apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
-        let k = rhs.ncols();
-        let n = self.llt.n;
-        let l = self.llt.supernodal();
-        let mut buf = self.llt.scratch(k);
-        let mut z = rhs.to_owned();
-        l.l_transpose_solve_with_conj(Conj::No, z.as_mut(), Par::Seq, MemStack::new(&mut buf));
-        let mut w = Mat::<f64>::zeros(n, k);
-        self.llt.permute_out(z.as_ref(), w.as_mut());
-        let mut mw = Mat::<f64>::zeros(n, k);
-        (self.apply_m)(w.as_ref(), mw.as_mut());
-        let mut out = out;
-        self.llt.permute_in(mw.as_ref(), out.as_mut());
-        l.l_solve_with_conj(Conj::No, out.as_mut(), Par::Seq, MemStack::new(&mut buf));
-    }
-    fn conj_apply(
-        &self,
-        out: MatMut<'_, f64>,
-        rhs: MatRef<'_, f64>,
-        par: Par,
-        stack: &mut MemStack,
-    ) {
-        self.apply(out, rhs, par, stack)
+    fn backward(&self, y: MatRef<'_, f64>, out: MatMut<'_, f64>) {
+        let mut z = y.to_owned();
+        let mut buf = self.scratch(y.ncols());
+        self.supernodal().l_transpose_solve_with_conj(
+            Conj::No,
+            z.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut buf),
+        );
+        self.permute_out(z.as_ref(), out);
     }
 }
 
 /// The `nev` lowest eigenpairs of K φ = λ M φ with K factorized in `llt` and M
-/// applied by `apply_m` (out = M x). Returns λ ascending and M-orthonormal φ.
+/// applied by `apply_m` (out = M x). Returns λ ascending and M-orthonormal φ
+/// (Krylov–Schur on the shift-invert operator, then two steps of subspace
+/// iteration: `shift_invert.rs`).
 pub fn lowest_eigenpairs(
     llt: &SparseCholesky,
     apply_m: impl Fn(MatRef<'_, f64>, MatMut<'_, f64>) + Sync,
     nev: usize,
 ) -> Result<(Vec<f64>, Mat<f64>), EigenError> {
-    let n = llt.n;
-    if nev == 0 {
-        return Ok((Vec::new(), Mat::zeros(n, 0)));
-    }
-    if nev > n {
-        return Err(EigenError::TooMany { requested: nev, n });
-    }
-    let op = ShiftInvert { llt, apply_m };
-    let params = PartialEigenParams::default();
-    let mut vecs = Mat::<f64>::zeros(n, nev);
-    let mut vals = vec![0.0f64; nev];
-    // a deterministic, generic start vector
-    let v0 = faer::Col::<f64>::from_fn(n, |i| {
-        1.0 + 0.37 * ((i as f64 * 0.618_033_988_75).fract() - 0.5)
-    });
-    let v0n = v0.norm_l2();
-    let v0 = v0 / v0n;
-    let req = partial_self_adjoint_eigen_scratch::<f64>(&op, nev, Par::Seq, params);
-    let mut buf = MemBuffer::new(req);
-    let info = partial_self_adjoint_eigen(
-        vecs.as_mut(),
-        &mut vals,
-        &op,
-        v0.as_ref(),
-        f64::EPSILON * 128.0,
-        Par::Seq,
-        MemStack::new(&mut buf),
-        params,
-    );
-    if info.n_converged_eigen < nev {
-        return Err(EigenError::PartialConvergence {
-            converged: info.n_converged_eigen,
-            requested: nev,
-        });
-    }
-    // back-transform: φ = Pᵀ L⁻ᵀ y, λ = 1/μ; M-normalize (φᵀMφ = μ for unit y).
-    let l = llt.supernodal();
-    let mut buf = llt.scratch(nev);
-    let mut z = vecs.clone();
-    l.l_transpose_solve_with_conj(Conj::No, z.as_mut(), Par::Seq, MemStack::new(&mut buf));
-    let mut phi = Mat::<f64>::zeros(n, nev);
-    llt.permute_out(z.as_ref(), phi.as_mut());
-    let mut pairs: Vec<(f64, usize)> = vals
-        .iter()
-        .enumerate()
-        .map(|(i, &mu)| (1.0 / mu, i))
-        .collect();
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut out = Mat::<f64>::zeros(n, nev);
-    let mut lam: Vec<f64> = Vec::with_capacity(nev);
-    for (c, &(l, i)) in pairs.iter().enumerate() {
-        if !(l.is_finite() && l > 0.0) {
-            return Err(EigenError::InvalidEigenvalue { value: l });
-        }
-        let s = (1.0 / vals[i]).sqrt() / vecs.col(i).norm_l2();
-        for r in 0..n {
-            out[(r, c)] = phi[(r, i)] * s;
-        }
-        lam.push(l);
-    }
-    // Two steps of shift-invert subspace iteration with Rayleigh–Ritz polish the
-    // Krylov–Schur pairs: Y = K⁻¹ M Φ, K_r = Yᵀ K Y = Yᵀ M Φ, M_r = Yᵀ M Y.
-    let mut phi = out;
-    for _ in 0..2 {
-        let mut mphi = Mat::<f64>::zeros(n, nev);
-        (op.apply_m)(phi.as_ref(), mphi.as_mut());
-        let mut y = mphi.clone();
-        llt.solve_in_place(y.as_mut());
-        let kr = y.transpose() * &mphi;
-        let mut my = Mat::<f64>::zeros(n, nev);
-        (op.apply_m)(y.as_ref(), my.as_mut());
-        let mr = y.transpose() * &my;
-        let kr = Mat::<f64>::from_fn(nev, nev, |i, j| 0.5 * (kr[(i, j)] + kr[(j, i)]));
-        let mr = Mat::<f64>::from_fn(nev, nev, |i, j| 0.5 * (mr[(i, j)] + mr[(j, i)]));
-        let e = generalized_eigen(kr.as_ref(), mr.as_ref(), nev, Definite::Either)?;
-        phi = &y * &e.vectors;
-        lam = e.values;
-    }
-    Ok((lam, phi))
+    lowest_pairs(llt, apply_m, nev, None)
 }
 
 #[cfg(test)]

@@ -40,8 +40,8 @@ mod sweep;
 
 pub use mac::{mac, mac_matrix, track_modes, Tracking};
 pub use modes::{
-    asymmetry, buckling_factors, damped_modes, generalized_symmetric, undamped_modes, DampedMode,
-    Modes,
+    asymmetry, buckling_factors, damped_modes, generalized_symmetric, undamped_modes,
+    undamped_modes_until, DampedMode, Modes,
 };
 pub use sweep::{sweep, sweep_until, SweepOptions, SweepOutcome, SweepParameter, SweepPoint};
 
@@ -106,6 +106,9 @@ pub enum LinearizeError {
         /// empty when the matrices come without one.
         at: String,
     },
+    /// The stop request was set ([`undamped_modes_until`]).
+    #[error("the eigen analysis was stopped on request")]
+    Interrupted,
     /// A configuration of a sweep failed: its equilibrium, its linearization
     /// or its eigen analysis.
     #[error("sweep configuration {index} of {count} ({at}): {message}")]

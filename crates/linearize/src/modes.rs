@@ -6,7 +6,10 @@ use crate::LinearizeError;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use flexmb_dynamics::Linearization;
-use flexmb_linalg::{generalized_eigen, generalized_eigenvalues, Definite, EigenError, Member};
+use flexmb_linalg::{
+    generalized_eigen_until, generalized_eigenvalues, Definite, EigenError, Member,
+};
+use std::sync::atomic::AtomicBool;
 
 /// Undamped modes, sorted by increasing ω².
 #[derive(Clone, Debug)]
@@ -57,6 +60,7 @@ fn eigen_error(
             Member::M => names[1],
         }),
         EigenError::NotPositiveDefinite { .. } => not_positive,
+        EigenError::Interrupted => LinearizeError::Interrupted,
         _ => LinearizeError::NoConvergence { at: String::new() },
     }
 }
@@ -72,13 +76,26 @@ pub fn generalized_symmetric(
     m: &Mat<f64>,
     count: usize,
 ) -> Result<Modes, LinearizeError> {
-    let e = generalized_eigen(k.as_ref(), m.as_ref(), count, Definite::Mass).map_err(|e| {
-        eigen_error(
-            e,
-            ["stiffness matrix", "mass matrix"],
-            LinearizeError::MassNotPositive { dofs: vec![] },
-        )
-    })?;
+    generalized_symmetric_until(k, m, count, None)
+}
+
+/// [`generalized_symmetric`] that ends with [`LinearizeError::Interrupted`]
+/// when `stop` is set ([`flexmb_linalg::generalized_eigen_until`]).
+fn generalized_symmetric_until(
+    k: &Mat<f64>,
+    m: &Mat<f64>,
+    count: usize,
+    stop: Option<&AtomicBool>,
+) -> Result<Modes, LinearizeError> {
+    let e = generalized_eigen_until(k.as_ref(), m.as_ref(), count, Definite::Mass, stop).map_err(
+        |e| {
+            eigen_error(
+                e,
+                ["stiffness matrix", "mass matrix"],
+                LinearizeError::MassNotPositive { dofs: vec![] },
+            )
+        },
+    )?;
     Ok(Modes {
         omega2: e.values,
         vectors: e.vectors,
@@ -87,9 +104,23 @@ pub fn generalized_symmetric(
 
 /// Undamped modes of a linearization: (K + G + N) v = ω² M v with the
 /// symmetric part of the stiffness (at rest with conservative loads the
-/// tangent is symmetric; its asymmetry is reported by [`asymmetry`]).
+/// tangent is symmetric; its asymmetry is reported by [`asymmetry`]). A few
+/// modes of a large model are found by Krylov–Schur, not by a full
+/// eigendecomposition ([`flexmb_linalg::eigen`]).
 pub fn undamped_modes(lin: &Linearization, count: usize) -> Result<Modes, LinearizeError> {
-    generalized_symmetric(&lin.stiffness_total(), &lin.m, count).map_err(|e| named(lin, e))
+    undamped_modes_until(lin, count, None)
+}
+
+/// [`undamped_modes`] that ends with [`LinearizeError::Interrupted`] when
+/// `stop` is set: it is read between the factorizations and the steps of the
+/// eigensolver ([`flexmb_linalg::generalized_eigen_until`]).
+pub fn undamped_modes_until(
+    lin: &Linearization,
+    count: usize,
+    stop: Option<&AtomicBool>,
+) -> Result<Modes, LinearizeError> {
+    generalized_symmetric_until(&lin.stiffness_total(), &lin.m, count, stop)
+        .map_err(|e| named(lin, e))
 }
 
 /// An analysis error of `lin`'s matrices with its culprit named from the

@@ -3,7 +3,7 @@
 //! linearization (E.6) and the undamped modes; the linearizations and eigen
 //! analyses run in parallel (rayon), each worker with its own dynamics.
 
-use crate::{undamped_modes, LinearizeError, Modes};
+use crate::{undamped_modes_until, LinearizeError, Modes};
 use faer::Mat;
 use flexmb_dynamics::{short_number, Dynamics, DynamicsError, StaticOptions};
 use flexmb_model::{ChartSwitch, Mechanism};
@@ -133,6 +133,9 @@ pub struct SweepOutcome {
     /// the configuration whose equilibrium switched it. The points' q,
     /// shapes and masses are still in the chart of the sweep's mechanism.
     pub chart_switches: Vec<(usize, ChartSwitch)>,
+    /// The Newton iterations of the equilibria, in all
+    /// ([`flexmb_dynamics::StaticSolution::iterations`]).
+    pub iterations: usize,
 }
 
 /// True if `stop` is given and set.
@@ -141,8 +144,10 @@ fn requested(stop: Option<&Arc<AtomicBool>>) -> bool {
 }
 
 /// [`sweep`] that ends early when `stop` is set: it is read before every
-/// configuration of both phases and by every Newton iteration of the
-/// equilibria ([`StaticOptions::stop`]). A sweep stopped while finding the
+/// configuration of the equilibria and by every Newton iteration
+/// ([`StaticOptions::stop`]), and inside the linearization and the eigen
+/// analysis of each configuration
+/// ([`Dynamics::linearize_at_rest_until`], [`undamped_modes_until`]). A sweep stopped while finding the
 /// equilibria has no modes; one stopped in the eigen analyses returns the
 /// configurations that are done.
 pub fn sweep_until(
@@ -165,10 +170,14 @@ pub fn sweep_until(
     // an orientation that turned far, and the continuation goes on in it
     let mut charts: Vec<Arc<Mechanism>> = Vec::with_capacity(n);
     let mut chart_switches = vec![];
+    let mut iterations = 0;
+    // the equilibria since the last chart switch or failed extrapolation,
+    // (s, q), at most the last three: the starting guess of the next one
+    let mut recent: Vec<(f64, Vec<f64>)> = Vec::with_capacity(3);
     // phase 1: equilibria by continuation
     for (i, &s) in opts.values.iter().enumerate() {
         if requested(stop) {
-            return Ok(stopped_early(i, chart_switches));
+            return Ok(stopped_early(i, chart_switches, iterations));
         }
         // the first equilibrium ramps the loads; the next ones continue from it
         let mut so = StaticOptions {
@@ -190,11 +199,45 @@ pub fn sweep_until(
                 so.held = dofs.iter().copied().zip(v).collect();
             }
         }
-        let sol = match dy.static_equilibrium(opts.t, &q, &so) {
+        // from the quadratic extrapolation of the last three equilibria
+        // (should that fail, from the last one)
+        // (a load sweep ramps the scale from the last equilibrium instead)
+        let extrapolated = recent.len() == 3 && !matches!(param, SweepParameter::LoadScale);
+        let guess = extrapolated.then(|| extrapolate(&recent, s));
+        let mut solved = match &guess {
+            Some(g) => dy.static_equilibrium(opts.t, g, &so),
+            None => dy.static_equilibrium(opts.t, &q, &so),
+        };
+        if guess.is_some() && !matches!(solved, Ok(_) | Err(DynamicsError::Interrupted)) {
+            recent.clear();
+            solved = dy.static_equilibrium(opts.t, &q, &so);
+        }
+        if i > 0
+            && matches!(param, SweepParameter::LoadScale)
+            && !matches!(solved, Ok(_) | Err(DynamicsError::Interrupted))
+        {
+            // the loads are not ramped from the last equilibrium (it carries
+            // them at its own scale): ramp the scale instead
+            recent.clear();
+            let s_prev = opts.values[i - 1];
+            solved = load_scale_steps(&mut dy, opts.t, &q, s_prev, s, &so, &mut iterations);
+        }
+        let sol = match solved {
             Ok(sol) => sol,
-            Err(DynamicsError::Interrupted) => return Ok(stopped_early(i, chart_switches)),
+            Err(DynamicsError::Interrupted) => {
+                return Ok(stopped_early(i, chart_switches, iterations))
+            }
             Err(e) => return Err(failed_at(mech, param, opts, i, e.to_string())),
         };
+        iterations += sol.iterations;
+        if !sol.chart_switches.is_empty() {
+            // the earlier equilibria are in other charts
+            recent.clear();
+        }
+        if recent.len() == 3 {
+            recent.remove(0);
+        }
+        recent.push((s, sol.q.clone()));
         q = sol.q;
         qs.push(q.clone());
         xs.push(sol.x);
@@ -222,33 +265,36 @@ pub fn sweep_until(
         .enumerate()
         .map(|(c, block)| {
             let mut dy = Dynamics::new(charts[c * chunk].clone());
-            block
-                .iter()
-                .enumerate()
-                .take_while(|_| !requested(stop))
-                .map(|(j, q)| {
-                    let i = c * chunk + j;
-                    if !Arc::ptr_eq(dy.mechanism(), &charts[i]) {
-                        dy = Dynamics::new(charts[i].clone());
-                    }
-                    dy.set_load_scale(scale[i]);
-                    dy.kinematics_mut().set_guess(&xs[i]);
-                    let fail = |m: String| failed_at(mech, param, opts, i, m);
-                    let lin = dy
-                        .linearize_at_rest(opts.t, q)
-                        .map_err(|e| fail(e.to_string()))?;
-                    let mut modes =
-                        undamped_modes(&lin, opts.modes).map_err(|e| fail(e.to_string()))?;
-                    let (mut q, mut m) = (q.clone(), lin.m);
-                    if !Arc::ptr_eq(&charts[i], mech) {
-                        (q, m) = in_sweep_chart(&mut dy, mech, &mut modes, m, opts.keep_vectors)
-                            .map_err(fail)?;
-                    }
-                    let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                    progress(d, total);
-                    Ok((i, q, modes, m))
-                })
-                .collect()
+            let flag = stop.map(|s| s.as_ref());
+            let mut out = Vec::with_capacity(block.len());
+            for (j, q) in block.iter().enumerate() {
+                let i = c * chunk + j;
+                if !Arc::ptr_eq(dy.mechanism(), &charts[i]) {
+                    dy = Dynamics::new(charts[i].clone());
+                }
+                dy.set_load_scale(scale[i]);
+                dy.kinematics_mut().set_guess(&xs[i]);
+                let fail = |m: String| failed_at(mech, param, opts, i, m);
+                let lin = match dy.linearize_at_rest_until(opts.t, q, flag) {
+                    Ok(lin) => lin,
+                    Err(DynamicsError::Interrupted) => break,
+                    Err(e) => return Err(fail(e.to_string())),
+                };
+                let mut modes = match undamped_modes_until(&lin, opts.modes, flag) {
+                    Ok(modes) => modes,
+                    Err(LinearizeError::Interrupted) => break,
+                    Err(e) => return Err(fail(e.to_string())),
+                };
+                let (mut q, mut m) = (q.clone(), lin.m);
+                if !Arc::ptr_eq(&charts[i], mech) {
+                    (q, m) = in_sweep_chart(&mut dy, mech, &mut modes, m, opts.keep_vectors)
+                        .map_err(fail)?;
+                }
+                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                progress(d, total);
+                out.push((i, q, modes, m));
+            }
+            Ok(out)
         })
         .collect();
     let mut points = Vec::with_capacity(n);
@@ -269,6 +315,7 @@ pub fn sweep_until(
         points,
         equilibria: n,
         chart_switches,
+        iterations,
     })
 }
 
@@ -311,11 +358,88 @@ fn in_sweep_chart(
 }
 
 /// The outcome of a sweep stopped after `equilibria` equilibria.
-fn stopped_early(equilibria: usize, chart_switches: Vec<(usize, ChartSwitch)>) -> SweepOutcome {
+fn stopped_early(
+    equilibria: usize,
+    chart_switches: Vec<(usize, ChartSwitch)>,
+    iterations: usize,
+) -> SweepOutcome {
     SweepOutcome {
         points: vec![],
         equilibria,
         stopped: true,
         chart_switches,
+        iterations,
     }
+}
+
+/// Smallest fraction of a load-scale interval that [`load_scale_steps`]
+/// steps by before giving up.
+const MIN_LOAD_SCALE_FRACTION: f64 = 1.0 / 1024.0;
+
+/// The equilibrium at load scale `s` continued from the equilibrium `q` at
+/// `s_prev` in steps of the load scale: half the interval first (the whole
+/// of it has failed), a step that fails is halved, one that converges is
+/// doubled for the next, down to [`MIN_LOAD_SCALE_FRACTION`] of the
+/// interval, each step ramped from its own start
+/// ([`StaticOptions::load_scale_from`]): the fallback when the continuation
+/// from the previous point in one ramp failed. Adds the Newton iterations of
+/// the intermediate equilibria to `iterations`; leaves the load scale at `s`.
+fn load_scale_steps(
+    dy: &mut Dynamics,
+    t: f64,
+    q: &[f64],
+    s_prev: f64,
+    s: f64,
+    so: &StaticOptions,
+    iterations: &mut usize,
+) -> Result<flexmb_dynamics::StaticSolution, DynamicsError> {
+    let interval = s - s_prev;
+    let (mut from, mut step, mut q) = (s_prev, 0.5 * interval, q.to_vec());
+    loop {
+        let last = (s - from).abs() <= step.abs();
+        let target = if last { s } else { from + step };
+        dy.set_load_scale(target);
+        let so = StaticOptions {
+            load_scale_from: so.load_scale_from.map(|_| from),
+            ..so.clone()
+        };
+        match dy.static_equilibrium(t, &q, &so) {
+            Ok(sol) if last => return Ok(sol),
+            Ok(sol) => {
+                *iterations += sol.iterations;
+                q = sol.q;
+                from = target;
+                step *= 2.0;
+            }
+            Err(DynamicsError::Interrupted) => return Err(DynamicsError::Interrupted),
+            Err(e) => {
+                step *= 0.5;
+                if step.abs() < MIN_LOAD_SCALE_FRACTION * interval.abs() {
+                    dy.set_load_scale(s);
+                    return Err(e);
+                }
+            }
+        }
+    }
+}
+
+/// The starting guess for the equilibrium at `s`: the quadratic through the
+/// last three equilibria (sᵢ, qᵢ), evaluated at s (Lagrange form). Its error
+/// is O(Δs³), against O(Δs²) for the tangent predictor of
+/// `static_equilibrium`, which starts from the last equilibrium alone: under
+/// gravity the sheet flexures' soft torsion amplifies the second-order error
+/// of that predictor (the first correction was 2e-4 against 1e-6 without
+/// gravity, issue 14 item 7), and Newton needed about twice the iterations.
+fn extrapolate(recent: &[(f64, Vec<f64>)], s: f64) -> Vec<f64> {
+    let w: Vec<f64> = (0..recent.len())
+        .map(|a| {
+            (0..recent.len())
+                .filter(|&b| b != a)
+                .map(|b| (s - recent[b].0) / (recent[a].0 - recent[b].0))
+                .product()
+        })
+        .collect();
+    (0..recent[0].1.len())
+        .map(|j| recent.iter().zip(&w).map(|((_, q), w)| w * q[j]).sum())
+        .collect()
 }

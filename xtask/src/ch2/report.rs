@@ -148,6 +148,9 @@ impl Done {
     }
 }
 
+/// A built spin-up segment: count, mesh, report line, FE frequencies (Hz).
+type BuiltSegment = (usize, SegmentMesh, String, Vec<f64>);
+
 fn spin_file(n: usize, mesh: SegmentMesh) -> String {
     format!("spin_up_se_{n}_m{}.se.ron", mesh.per_metre)
 }
@@ -171,7 +174,7 @@ pub fn compute(dir: &Path, o: &Ch2Options, pg: &Progress) -> Result<Results, Str
         .collect();
     builds.extend(meshes[1..].iter().map(|&m| (4, m)));
     let bar = pg.bar("build superelements", builds.len() as u64 + 2);
-    let built: Vec<Result<(usize, SegmentMesh, String, Vec<f64>), String>> = builds
+    let built: Vec<Result<BuiltSegment, String>> = builds
         .par_iter()
         .map(|&(n, mesh)| {
             let fe_modes = if n == 4 && mesh == spin_up::MESH {
