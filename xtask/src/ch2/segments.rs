@@ -8,7 +8,7 @@ use flexmb_superelement::parts::{self, Part, ShaftHalf};
 use flexmb_superelement::{build, spec, BuildResult};
 use std::path::Path;
 
-/// The aluminium of the spin-up benchmarks (Kane–Ryan–Banerjee [45]):
+/// The aluminium of the spin-up benchmarks (Kane, Ryan and Banerjee, thesis ref. 45):
 /// E = 6.895e10 Pa, ρ = 2766.67 kg/m³, ν = 0.3 (G = E/2.6).
 pub fn aluminium() -> Material {
     Material {
