@@ -3,7 +3,7 @@
 //! the beam segments, against flexmb's non-linear beams.
 
 use flexmb_element::VelocityTransform::{self, B1, B2, B3};
-use xtask::ch2::report::euler_bernoulli_clamped_free;
+use xtask::ch2::report::{euler_bernoulli_clamped_free, nearest};
 use xtask::ch2::segments;
 use xtask::ch2::spin_up::{self, Integration};
 
@@ -22,16 +22,7 @@ fn the_spin_up_segment_fe_model_bends_as_an_euler_bernoulli_beam() {
     let b = spin_up::segment(4, spin_up::MESH, 40).unwrap();
     let eb = euler_bernoulli_clamped_free(2.0);
     for (k, (target, tol)) in eb.iter().zip([5e-3, 1e-2]).enumerate() {
-        let nearest = b
-            .fe_frequencies
-            .iter()
-            .copied()
-            .min_by(|a, c| {
-                (a / target - 1.0)
-                    .abs()
-                    .total_cmp(&(c / target - 1.0).abs())
-            })
-            .unwrap();
+        let nearest = nearest(&b.fe_frequencies, *target);
         let e = nearest / target - 1.0;
         assert!(
             e.abs() < tol,

@@ -376,7 +376,7 @@ fn a_closed_stdout_does_not_stop_the_files_or_change_the_exit_code() {
 }
 
 /// `flexmb sweep --reduced` (a 3-coordinate modal model of the planar
-/// guidance, 30000 load scales): the reduced equilibria have nothing
+/// guidance, 300 000 load scales): the reduced equilibria have nothing
 /// partial (exit at once), the eigen analyses after them do. SIGTERM some
 /// seconds in (in the eigen analyses on this machine) exits with 143 within
 /// [`EXIT_WITHIN`]; if it came in the eigen analyses, the rows written are
@@ -397,6 +397,10 @@ fn an_interrupted_reduced_sweep_exits_143_with_the_partial_frequencies() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let model = model.to_str().unwrap();
+    // many points, so that the sweep is still running when the signal comes
+    // on an idle machine too (30 000 could finish within the 6 s)
+    const N: usize = 300_000;
+    let n = N.to_string();
     let args = [
         "sweep",
         scene,
@@ -409,7 +413,7 @@ fn an_interrupted_reduced_sweep_exits_143_with_the_partial_frequencies() {
         "--to",
         "1",
         "--n",
-        "30000",
+        n.as_str(),
         "--modes",
         "2",
     ];
@@ -428,11 +432,11 @@ fn an_interrupted_reduced_sweep_exits_143_with_the_partial_frequencies() {
             .split_once("partial results written: ")
             .unwrap_or_else(|| panic!("{err}"));
         let done: usize = done.split(' ').next().unwrap().parse().unwrap();
-        assert!((1..30000).contains(&done), "{err}");
+        assert!((1..N).contains(&done), "{err}");
         assert_eq!(rows(&csv).len(), done, "{err}");
         let text = std::fs::read_to_string(&csv).unwrap();
         assert!(
-            text.contains(&format!("# interrupted: {done} of 30000")),
+            text.contains(&format!("# interrupted: {done} of {N}")),
             "{text}"
         );
     }

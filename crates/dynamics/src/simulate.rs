@@ -644,7 +644,6 @@ impl Dynamics {
             (q, qd) = (q1, qd1);
         }
         let mut times = opts.output_times.clone();
-        let mut first = true;
         loop {
             let seg_opts = SimulationOptions {
                 output_times: times.clone(),
@@ -659,8 +658,8 @@ impl Dynamics {
                 &mut traj,
                 &mut observer,
             )?;
-            accumulate(&mut traj.stats, &stats, first);
-            first = false;
+            // the counts of every segment between chart switches
+            traj.stats.accumulate(&stats);
             traj.stopped = stopped;
             let Some((ts, qs, qds)) = switch_at else {
                 break;
@@ -917,29 +916,5 @@ impl Dynamics {
         self.load_factor = lf;
         self.load_scale = ls;
         self.evaluations = ev;
-    }
-}
-
-/// Adds the counts of a restarted segment to the run's statistics.
-fn accumulate(total: &mut Stats, seg: &Stats, first: bool) {
-    if first {
-        *total = seg.clone();
-        return;
-    }
-    total.rhs_evals += seg.rhs_evals;
-    total.steps_accepted += seg.steps_accepted;
-    total.steps_rejected += seg.steps_rejected;
-    total.newton_iterations += seg.newton_iterations;
-    total.newton_failures += seg.newton_failures;
-    total.jacobian_evals += seg.jacobian_evals;
-    total.lu_decompositions += seg.lu_decompositions;
-    if seg.steps_accepted > 0 {
-        total.last_step = seg.last_step;
-        total.min_step = if total.min_step == 0.0 {
-            seg.min_step
-        } else {
-            total.min_step.min(seg.min_step)
-        };
-        total.max_step = total.max_step.max(seg.max_step);
     }
 }

@@ -257,10 +257,18 @@ impl DeformationKernel<2, 1> for PlanarHingeKernel {
 }
 
 /// The spatial hinge on x = (λp, λq) with its axis along the local x-axis of R0:
-/// ε1 = the relative rotation about the axis, continuous over any number of turns
-/// (atan2 of the triad products plus `turns` · 2π chosen against the previous
-/// value), ε2 = (ep_x·eq_z − ep_z·eq_x)/2 and ε3 = (ep_y·eq_x − ep_x·eq_y)/2 the
-/// small relative rotations about the other two axes (normally rigid).
+/// ε1 = θ, the relative rotation about the axis, continuous over any number of
+/// turns (atan2 of the triad products plus `turns` · 2π chosen against the
+/// previous value); ε2 = a·m_y and ε3 = a·m_z the small relative rotations about
+/// the other two axes (normally rigid), with a = ep_x × eq_x the misalignment of
+/// the two axes and m the frame halfway between the nodes about the axis,
+/// m_y = (R_p(θ/2) ep_y + R_q(−θ/2) eq_y)/2 (likewise m_z). For small rotations
+/// ε2, ε3 are the SPACAR measures (ep_x·eq_z − ep_z·eq_x)/2 and
+/// (ep_y·eq_x − ep_x·eq_y)/2, but those lose the tilt as θ reaches π: their
+/// derivative with respect to a tilt is (1 + cos θ)/2, so a hinge with free
+/// bending was singular at half a turn. Measured in the half-way frame the
+/// tilt's derivative is a rotation by θ/2 for every θ; swapping p and q still
+/// negates all three (θ ↦ −θ keeps m, a ↦ −a).
 pub(crate) struct SpatialHingeKernel {
     pub r0: [[f64; 3]; 3],
     /// 2πk added to ε1 (a constant: it does not change derivatives).
@@ -293,9 +301,14 @@ impl DeformationKernel<8, 3> for SpatialHingeKernel {
         let s = p[2].dot(&q[1]) - p[1].dot(&q[2]);
         let c = p[1].dot(&q[1]) + p[2].dot(&q[2]);
         let e1 = s.atan2(c) + self.offset;
-        let e2 = (p[0].dot(&q[2]) - p[2].dot(&q[0])) * 0.5;
-        let e3 = (p[1].dot(&q[0]) - p[0].dot(&q[1])) * 0.5;
-        [e1, e2, e3]
+        let half = e1 * 0.5;
+        // half of cos(θ/2), sin(θ/2): R_p(θ/2) and R_q(−θ/2) of the y and z
+        // axes, averaged
+        let (ch, sh) = (half.cos() * 0.5, half.sin() * 0.5);
+        let my = p[1].scale(ch) + p[2].scale(sh) + q[1].scale(ch) - q[2].scale(sh);
+        let mz = p[2].scale(ch) - p[1].scale(sh) + q[2].scale(ch) + q[1].scale(sh);
+        let a = p[0].cross(&q[0]);
+        [e1, a.dot(&my), a.dot(&mz)]
     }
 }
 

@@ -54,6 +54,29 @@ impl Stats {
         self.last_step = h;
         self.steps_accepted += 1;
     }
+
+    /// Adds the counts of `segment`, a later run restarted where this one
+    /// ended (e.g. after an Euler-chart switch), so that the totals are
+    /// those of the whole run: the counts add up, the step sizes keep the
+    /// extremes over both and the last one of the latest run that stepped.
+    pub fn accumulate(&mut self, segment: &Stats) {
+        self.rhs_evals += segment.rhs_evals;
+        self.steps_accepted += segment.steps_accepted;
+        self.steps_rejected += segment.steps_rejected;
+        self.newton_iterations += segment.newton_iterations;
+        self.newton_failures += segment.newton_failures;
+        self.jacobian_evals += segment.jacobian_evals;
+        self.lu_decompositions += segment.lu_decompositions;
+        if segment.steps_accepted > 0 {
+            self.last_step = segment.last_step;
+            self.min_step = if self.min_step == 0.0 {
+                segment.min_step
+            } else {
+                self.min_step.min(segment.min_step)
+            };
+            self.max_step = self.max_step.max(segment.max_step);
+        }
+    }
 }
 
 impl fmt::Display for Stats {
@@ -497,5 +520,44 @@ mod tests {
         assert!(Output::Times(vec![0.5, 0.2]).validate(0.0, 1.0).is_err());
         assert!(Output::Times(vec![1.5]).validate(0.0, 1.0).is_err());
         assert!(Output::Times(vec![f64::NAN]).validate(0.0, 1.0).is_err());
+    }
+
+    /// A run restarted after a chart switch: accumulated into the default
+    /// (empty) statistics a segment is copied, and a second one adds its
+    /// counts and keeps the extreme step sizes and its own last step. A
+    /// segment without steps leaves the step sizes alone.
+    #[test]
+    fn restarted_segments_accumulate() {
+        let seg = |evals, accepted, min, max, last| Stats {
+            rhs_evals: evals,
+            steps_accepted: accepted,
+            steps_rejected: 1,
+            newton_iterations: 2,
+            newton_failures: 0,
+            jacobian_evals: 1,
+            lu_decompositions: 3,
+            last_step: last,
+            min_step: min,
+            max_step: max,
+        };
+        let a = seg(10, 4, 0.01, 0.1, 0.05);
+        let mut total = Stats::default();
+        total.accumulate(&a);
+        assert_eq!(total, a);
+        total.accumulate(&seg(6, 2, 0.002, 0.05, 0.03));
+        assert_eq!(
+            (total.rhs_evals, total.steps_accepted, total.steps_rejected),
+            (16, 6, 2)
+        );
+        assert_eq!((total.newton_iterations, total.lu_decompositions), (4, 6));
+        assert_eq!(
+            (total.min_step, total.max_step, total.last_step),
+            (0.002, 0.1, 0.03)
+        );
+        total.accumulate(&seg(1, 0, 0.0, 0.0, 0.0));
+        assert_eq!(
+            (total.min_step, total.max_step, total.last_step),
+            (0.002, 0.1, 0.03)
+        );
     }
 }

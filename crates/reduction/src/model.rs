@@ -546,7 +546,6 @@ impl ReducedModel {
         };
         let (mut t_now, mut z, mut zd) = (t0, z0.to_vec(), zd0.to_vec());
         let mut times = opts.output_times.clone();
-        let mut first = true;
         loop {
             self.switch_charts(t_now, &mut z, &mut zd, &mut tr.chart_switches)?;
             self.watch = ChartWatch::new(self);
@@ -590,8 +589,8 @@ impl ReducedModel {
             if let Some(e) = failure {
                 return Err(e.into());
             }
-            accumulate(&mut tr.stats, &stats, first);
-            first = false;
+            // the counts of every segment between chart switches
+            tr.stats.accumulate(&stats);
             let switch_at = self.watch.switch_at.take();
             tr.stopped = stopped && (observer_stopped || switch_at.is_none());
             let Some((ts, zs, zds)) = switch_at else {
@@ -679,30 +678,6 @@ fn euler_rate(mech: &Mechanism, i: usize, x: &[f64], qd: &[f64]) -> f64 {
         .find(|c| c.dependent == i)
         .map(|c| -c.dofs.iter().map(|(k, m)| x[*m] * qd[*k]).sum::<f64>() / x[i])
         .unwrap_or(0.0)
-}
-
-/// Adds the counts of a restarted segment to the run's statistics.
-fn accumulate(total: &mut flexmb_ode::Stats, seg: &flexmb_ode::Stats, first: bool) {
-    if first {
-        *total = seg.clone();
-        return;
-    }
-    total.rhs_evals += seg.rhs_evals;
-    total.steps_accepted += seg.steps_accepted;
-    total.steps_rejected += seg.steps_rejected;
-    total.newton_iterations += seg.newton_iterations;
-    total.newton_failures += seg.newton_failures;
-    total.jacobian_evals += seg.jacobian_evals;
-    total.lu_decompositions += seg.lu_decompositions;
-    if seg.steps_accepted > 0 {
-        total.last_step = seg.last_step;
-        total.min_step = if total.min_step == 0.0 {
-            seg.min_step
-        } else {
-            total.min_step.min(seg.min_step)
-        };
-        total.max_step = total.max_step.max(seg.max_step);
-    }
 }
 
 /// What the integration of a reduced model watches between steps: the

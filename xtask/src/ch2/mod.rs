@@ -7,6 +7,7 @@
 //! is built by flexmb's builder from a solid FE model (built-in 20-node
 //! hexahedra). `cargo xtask reproduce ch2` writes `results/ch2/`.
 
+pub mod chain;
 pub mod curves;
 pub mod report;
 pub mod segments;

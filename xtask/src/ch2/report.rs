@@ -624,13 +624,10 @@ fn spin_up_section(
     md.push_str(&t.render());
 
     // the figure and its CSV
-    let mut p = Plot::new(
+    let mut fig = TimeFigure::new(
         "Spin-up beam: tip deflection in the rotating frame (4 elements)",
-        "t (s)",
         "Δy′ (m)",
     );
-    let mut header = vec!["t".to_string()];
-    let mut cols: Vec<Vec<f64>> = vec![];
     for k in [
         beams,
         Kind::Beam { shortening: true },
@@ -639,21 +636,11 @@ fn spin_up_section(
         Kind::Superelement(B3),
     ] {
         if let Some(x) = r.spin(k, 4, spin_up::MESH, Integrator::Dopri5) {
-            if cols.is_empty() {
-                cols.push(x.tip.t.clone());
-            }
-            header.push(k.label());
-            cols.push(x.tip.dy.clone());
-            p.push(match k {
-                Kind::Superelement(B1) | Kind::Superelement(B2) => {
-                    Series::dashed(&k.label(), &x.tip.t, &x.tip.dy)
-                }
-                _ => Series::line(&k.label(), &x.tip.t, &x.tip.dy),
-            });
+            let dashed = matches!(k, Kind::Superelement(B1) | Kind::Superelement(B2));
+            fig.add(&k.label(), &x.tip.t, x.tip.dy.clone(), dashed);
         }
     }
-    write_columns(&out.join("spin_up_tip.csv"), &header, &cols)?;
-    figs.save(&p, out, "spin_up_tip").map_err(io)?;
+    fig.save(out, "spin_up_tip", figs)?;
     md.push_str(&figs.markdown(|s| s == "spin_up_tip"));
 
     // speed against error rows
@@ -704,6 +691,42 @@ pub fn converged_value(r: &Results, counts: &[usize], k: spin_up::Kind) -> Optio
         })
         .collect::<Option<_>>()?;
     richardson(v[0], v[1], v[2])
+}
+
+/// A figure of signals over time, written with its CSV (one column per
+/// series, the time first).
+struct TimeFigure {
+    plot: Plot,
+    header: Vec<String>,
+    cols: Vec<Vec<f64>>,
+}
+
+impl TimeFigure {
+    fn new(title: &str, ylabel: &str) -> Self {
+        Self {
+            plot: Plot::new(title, "t (s)", ylabel),
+            header: vec!["t".into()],
+            cols: vec![],
+        }
+    }
+    /// A series (all of them at the same output times `t`).
+    fn add(&mut self, label: &str, t: &[f64], y: Vec<f64>, dashed: bool) {
+        if self.cols.is_empty() {
+            self.cols.push(t.to_vec());
+        }
+        self.plot.push(if dashed {
+            Series::dashed(label, t, &y)
+        } else {
+            Series::line(label, t, &y)
+        });
+        self.header.push(label.into());
+        self.cols.push(y);
+    }
+    /// Writes `out/stem.csv` and the figure, and embeds it in the report.
+    fn save(self, out: &Path, stem: &str, figs: &mut Figures) -> Result<(), String> {
+        write_columns(&out.join(format!("{stem}.csv")), &self.header, &self.cols)?;
+        figs.save(&self.plot, out, stem).map_err(io)
+    }
 }
 
 fn write_columns(path: &Path, header: &[String], cols: &[Vec<f64>]) -> Result<(), String> {
@@ -852,14 +875,11 @@ fn uj_section(out: &Path, r: &Results, md: &mut String, figs: &mut Figures) -> R
         let _ = writeln!(md, "\nThe thesis's claims:\n\n- *Only B1 is sensitive to the reversal; B2's and B3's differences are numerical.* Reproduced: B1's reversed response differs by {:.2e} m, B2's and B3's by at most {b23:.1e} m, of the order of rtol × the response (the beams: {:.1e} m). Asserted over 0–6 s in `xtask/tests/ch2_claims.rs`.\n- *B3 is at least as close to the beams as B2, and B2 closer than B1.* Not reproduced: here {closest} is the closest out of the plane, and the three differ among themselves by {:.3} m, less than each one's difference from the beams (at least {lo:.3} m over 20 s, mostly a drift of phase). That difference is the superelements' FE model against beam theory (see the FE mesh study of Table 2.1), not the velocity transformation, so it cannot rank B1, B2 and B3.\n", c.per_transform[0].2[0], c.beams_reversal[0].max(c.beams_reversal[1]), hi - lo);
     }
     // figures: Δy′ and Δz′ of each model, and the reversal differences
-    for (k, name) in [(0, "Δy′"), (1, "Δz′")] {
-        let mut p = Plot::new(
+    for (k, name, stem) in [(0, "Δy′", "uj_dy"), (1, "Δz′", "uj_dz")] {
+        let mut fig = TimeFigure::new(
             &format!("Universal joint: tip {name} in the joint frame"),
-            "t (s)",
             &format!("{name} (m)"),
         );
-        let mut header = vec!["t".to_string()];
-        let mut cols = vec![];
         for kind in [
             uj::Kind::Beam,
             uj::Kind::Superelement(B1),
@@ -867,25 +887,14 @@ fn uj_section(out: &Path, r: &Results, md: &mut String, figs: &mut Figures) -> R
             uj::Kind::Superelement(B3),
         ] {
             if let Some(x) = r.uj_run(kind, false, rtol) {
-                if cols.is_empty() {
-                    cols.push(x.tip.t.clone());
-                }
-                let y: Vec<f64> = x.tip.d.iter().map(|d| d[k]).collect();
-                header.push(kind.label());
-                p.push(if kind == uj::Kind::Beam {
-                    Series::line(&kind.label(), &x.tip.t, &y)
-                } else {
-                    Series::dashed(&kind.label(), &x.tip.t, &y)
-                });
-                cols.push(y);
+                let y = x.tip.d.iter().map(|d| d[k]).collect();
+                fig.add(&kind.label(), &x.tip.t, y, kind != uj::Kind::Beam);
             }
         }
-        let stem = if k == 0 { "uj_dy" } else { "uj_dz" };
-        write_columns(&out.join(format!("{stem}.csv")), &header, &cols)?;
-        figs.save(&p, out, stem).map_err(io)?;
+        fig.save(out, stem, figs)?;
     }
     let mut p = Plot::new(
-        "Fig. 2.12: original minus reversed, Δz′",
+        "Fig. 2.12: original minus reversed, Δy′ (out of the spin plane)",
         "t (s)",
         "difference (m)",
     );
@@ -899,7 +908,7 @@ fn uj_section(out: &Path, r: &Results, md: &mut String, figs: &mut Figures) -> R
                 .d
                 .iter()
                 .zip(&b.tip.d)
-                .map(|(x, y)| x[1] - y[1])
+                .map(|(x, y)| x[0] - y[0])
                 .collect();
             p.push(Series::line(&format!("{t:?}"), &a.tip.t, &d));
         }

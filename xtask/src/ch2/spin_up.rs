@@ -5,12 +5,11 @@
 //! of the beam segments. The measured quantity is the maximum tip deflection
 //! Δy′ in the frame rotating with the root over 0–20 s.
 
+use super::chain;
 use super::segments::{self, Built, SegmentMesh};
-use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions};
+use flexmb_dynamics::Integrator;
 use flexmb_element::VelocityTransform;
-use flexmb_model::Scene;
 use std::path::Path;
-use std::sync::Arc;
 
 /// Beam length (m).
 pub const L: f64 = 8.0;
@@ -84,11 +83,12 @@ pub fn beam_scene(n: usize, shortening: bool) -> String {
 /// bending about the element y axis (out of the plane) rigid, like the
 /// elongation.
 pub fn superelement_scene(n: usize, file: &str, t: VelocityTransform) -> String {
-    let h = L / n as f64;
+    let (chain_nodes, links) = chain::links(n, L);
     let mut nodes = vec![
         r#"(id: "G", at: [0.0, 0.0, 0.0])"#.to_string(),
         r#"(id: "N0", at: [0.0, 0.0, 0.0])"#.to_string(),
     ];
+    nodes.extend(chain_nodes);
     let mut elements = vec![
         r#"(id: "drive", type: Hinge(nodes: ("G", "N0"), axis: Some([0.0, 0.0, 1.0])))"#
             .to_string(),
@@ -97,19 +97,9 @@ pub fn superelement_scene(n: usize, file: &str, t: VelocityTransform) -> String 
         r#"Def("drive", "bending_y")"#.to_string(),
         r#"Def("drive", "bending_z")"#.to_string(),
     ];
-    for k in 1..=n {
-        let id = if k == n {
-            "T".to_string()
-        } else {
-            format!("N{k}")
-        };
-        let prev = format!("N{}", k - 1);
-        nodes.push(format!(
-            r#"(id: "{id}", at: [{:.15}, 0.0, 0.0])"#,
-            h * k as f64
-        ));
+    for chain::Link { k, from, to } in links {
         elements.push(format!(
-            r#"(id: "se{k}", type: Superelement(nodes: ("{prev}", "{id}"), file: "{file}", transform: {t:?}))"#
+            r#"(id: "se{k}", type: Superelement(nodes: ("{from}", "{to}"), file: "{file}", transform: {t:?}))"#
         ));
         for d in ["elongation", "torsion", "bending_y_p", "bending_y_q"] {
             rigid.push(format!(r#"Def("se{k}", "{d}")"#));
@@ -194,29 +184,25 @@ impl Integration {
 /// reference configuration over 0–T_END and returns Δy′ = −sin e x_T +
 /// cos e y_T, e the prescribed spin angle (2.41).
 pub fn run(scene: &str, dir: &Path, how: Integration) -> Result<TipHistory, String> {
-    let scene = Scene::from_ron_str(scene).map_err(|e| e.to_string())?;
-    let mech = Arc::new(scene.build(Some(dir)).map_err(|e| e.to_string())?);
-    let tip = mech
-        .node("T")
-        .ok_or("the scene has no node T")?
-        .position
-        .clone();
-    let spin = mech
+    let r = chain::run_from_rest(
+        scene,
+        dir,
+        how.integrator,
+        how.rtol,
+        how.atol,
+        T_END,
+        OUTPUTS,
+    )?;
+    let tip = r.position_of("T")?;
+    let spin = r
+        .mech
         .inputs
         .first()
         .ok_or("the scene has no prescribed spin")?
         .function
         .clone();
-    let mut dy = Dynamics::new(mech.clone());
-    let q0 = mech.q0();
-    let qd0 = vec![0.0; q0.len()];
-    let mut opts = SimulationOptions::new(how.integrator, 0.0, T_END, OUTPUTS);
-    opts.rtol = how.rtol;
-    opts.atol = how.atol;
-    let tr = dy
-        .simulate(0.0, &q0, &qd0, &opts, |_, _, _| Control::Continue)
-        .map_err(|e| format!("{}: {e}", mech.name))?;
-    let d =
+    let tr = &r.trajectory;
+    let dy =
         tr.t.iter()
             .zip(&tr.x)
             .map(|(t, x)| {
@@ -225,11 +211,11 @@ pub fn run(scene: &str, dir: &Path, how: Integration) -> Result<TipHistory, Stri
             })
             .collect();
     Ok(TipHistory {
-        t: tr.t,
-        dy: d,
+        t: tr.t.clone(),
+        dy,
         evaluations: tr.stats.rhs_evals as u64,
         wall_time: tr.wall_time,
-        dof: mech.n_dof(),
+        dof: r.mech.n_dof(),
     })
 }
 

@@ -10,12 +10,11 @@
 //! that Δy′ (out of the spin plane) and Δz′ (in it, the lag) are the tip's
 //! components in the joint frame R_y(e1) R_z(e2).
 
+use super::chain;
 use super::segments::{self, Built, SegmentMesh};
-use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions};
+use flexmb_dynamics::Integrator;
 use flexmb_element::VelocityTransform;
-use flexmb_model::Scene;
 use std::path::Path;
-use std::sync::Arc;
 
 /// Beam length (m).
 pub const L: f64 = 8.0;
@@ -57,7 +56,6 @@ impl Kind {
 /// with p → q along +x, or along −x when `reversed`). `reversed` lists each
 /// element's nodes outer end first.
 pub fn scene(kind: Kind, reversed: bool, file: &str) -> String {
-    let h = L / N as f64;
     let mut nodes = vec![
         r#"(id: "G", at: [0.0, 0.0, 0.0])"#.to_string(),
         r#"(id: "U", at: [0.0, 0.0, 0.0])"#.to_string(),
@@ -78,18 +76,10 @@ pub fn scene(kind: Kind, reversed: bool, file: &str) -> String {
             ]
         })
         .collect();
-    for k in 1..=N {
-        let id = if k == N {
-            "T".to_string()
-        } else {
-            format!("N{k}")
-        };
-        let prev = format!("N{}", k - 1);
-        nodes.push(format!(
-            r#"(id: "{id}", at: [{:.15}, 0.0, 0.0])"#,
-            h * k as f64
-        ));
-        let (a, b) = if reversed { (&id, &prev) } else { (&prev, &id) };
+    let (chain_nodes, links) = chain::links(N, L);
+    nodes.extend(chain_nodes);
+    for chain::Link { k, from, to } in links {
+        let (a, b) = if reversed { (&to, &from) } else { (&from, &to) };
         elements.push(match kind {
             // local y along global z: the 0.04 m side in the spin plane
             Kind::Beam => format!(
@@ -178,26 +168,21 @@ pub fn run(
     outputs: usize,
     rtol: f64,
 ) -> Result<TipResponse, String> {
-    let scene = Scene::from_ron_str(scene).map_err(|e| e.to_string())?;
-    let mech = Arc::new(scene.build(Some(dir)).map_err(|e| e.to_string())?);
-    let tip = mech
-        .node("T")
-        .ok_or("the scene has no node T")?
-        .position
-        .clone();
-    let (e1, e2) = match mech.inputs.as_slice() {
+    let r = chain::run_from_rest(
+        scene,
+        dir,
+        Integrator::Dopri5,
+        rtol,
+        rtol * 1e-3,
+        t_end,
+        outputs,
+    )?;
+    let tip = r.position_of("T")?;
+    let (e1, e2) = match r.mech.inputs.as_slice() {
         [a, b] => (a.function.clone(), b.function.clone()),
         _ => return Err("the scene needs the two joint inputs".into()),
     };
-    let mut dy = Dynamics::new(mech.clone());
-    let q0 = mech.q0();
-    let qd0 = vec![0.0; q0.len()];
-    let mut opts = SimulationOptions::new(Integrator::Dopri5, 0.0, t_end, outputs);
-    opts.rtol = rtol;
-    opts.atol = rtol * 1e-3;
-    let tr = dy
-        .simulate(0.0, &q0, &qd0, &opts, |_, _, _| Control::Continue)
-        .map_err(|e| format!("{}: {e}", mech.name))?;
+    let tr = &r.trajectory;
     let d =
         tr.t.iter()
             .zip(&tr.x)
@@ -212,7 +197,7 @@ pub fn run(
             })
             .collect();
     Ok(TipResponse {
-        t: tr.t,
+        t: tr.t.clone(),
         d,
         evaluations: tr.stats.rhs_evals as u64,
         wall_time: tr.wall_time,
