@@ -4,7 +4,7 @@
 //! interfaces, §2.2), thesis (2.17).
 
 use flexmb_element::{LinearSuperelement, Material};
-use flexmb_superelement::parts::{self, Part, ShaftHalf};
+use flexmb_superelement::parts::{self, Part};
 use flexmb_superelement::{build, spec, BuildResult};
 use std::path::Path;
 
@@ -15,15 +15,6 @@ pub fn aluminium() -> Material {
         e: 6.895e10,
         g: 6.895e10 / 2.6,
         rho: 2766.67,
-    }
-}
-
-/// The steel of Table 2.2: E = 2.1e11 Pa, G = 8.0e10 Pa, ρ = 7800 kg/m³.
-pub fn steel() -> Material {
-    Material {
-        e: 2.1e11,
-        g: 8.0e10,
-        rho: 7800.0,
     }
 }
 
@@ -99,20 +90,6 @@ pub fn beam_segment(
     let part = parts::prismatic_bar(l, by, bz, n, aluminium()).map_err(|e| e.to_string())?;
     let part = if reversed { part.reversed() } else { part };
     finish(&part, "segment", fe_modes)
-}
-
-/// Half of the unbalanced shaft (Table 2.2), rod length `rod_len`, joined at
-/// its q node (the middle) or, `joined_at_p`, at its p node (Fig. 2.16).
-pub fn shaft_half(
-    half: ShaftHalf,
-    rod_len: f64,
-    n_section: usize,
-    joined_at_p: bool,
-) -> Result<Built, String> {
-    let part = parts::unbalanced_shaft_half(half, rod_len, n_section, 8, 4, steel())
-        .map_err(|e| e.to_string())?;
-    let part = if joined_at_p { part.reversed() } else { part };
-    finish(&part, "shaft half", 0)
 }
 
 /// Writes a superelement file.
