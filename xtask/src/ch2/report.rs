@@ -598,7 +598,7 @@ fn spin_up_section(
             );
         }
     }
-    let _ = writeln!(md, "\nOrder of convergence p = log2((d_n − d_2n)/(d_2n − d_4n)) from the three finest models, and the Richardson value:\n\n{conv}\nBoth beam formulations converge at order 2 to the same value. The superelements, at a fixed FE mesh density (10 hexahedra per metre), do not converge to it: each added segment adds two rigid interface faces, and the mesh is not converged along the beam (the table below), so their limit is that of a slightly different FE model. Converging them needs the FE mesh refined with the element count; that study is not done yet.\n");
+    let _ = writeln!(md, "\nOrder of convergence p = log2((d_n − d_2n)/(d_2n − d_4n)) from the three finest models, and the Richardson value:\n\n{conv}\nBoth beam formulations approach the same value. The superelements, at a fixed FE mesh density (10 hexahedra per metre), do not converge to it: each added segment adds two rigid interface faces, and the mesh is not converged along the beam (the table below), so their limit is that of a slightly different FE model. Converging them needs the FE mesh refined with the element count; that study is not done yet.\n");
     let reference = converged.map(|c| c.1).unwrap_or(f64::NAN);
 
     // FE mesh convergence
