@@ -522,13 +522,7 @@ fn spin_up_section(
         Kind::Superelement(_) => Some(spin_up::THESIS[2].1),
         _ => None,
     };
-    for k in [
-        beams,
-        Kind::Beam { shortening: true },
-        Kind::Superelement(B1),
-        Kind::Superelement(B2),
-        Kind::Superelement(B3),
-    ] {
+    for k in spin_up::TABLE_MODELS {
         if let Some(x) = r.spin(k, 4, spin_up::MESH, Integrator::Dopri5) {
             let th = thesis(k);
             t.row(vec![
@@ -628,13 +622,7 @@ fn spin_up_section(
         "Spin-up beam: tip deflection in the rotating frame (4 elements)",
         "Δy′ (m)",
     );
-    for k in [
-        beams,
-        Kind::Beam { shortening: true },
-        Kind::Superelement(B1),
-        Kind::Superelement(B2),
-        Kind::Superelement(B3),
-    ] {
+    for k in spin_up::TABLE_MODELS {
         if let Some(x) = r.spin(k, 4, spin_up::MESH, Integrator::Dopri5) {
             let dashed = matches!(k, Kind::Superelement(B1) | Kind::Superelement(B2));
             fig.add(&k.label(), &x.tip.t, x.tip.dy.clone(), dashed);
@@ -790,12 +778,7 @@ fn uj_section(out: &Path, r: &Results, md: &mut String, figs: &mut Figures) -> R
         "evaluations",
         "wall time (s)",
     ]);
-    for kind in [
-        uj::Kind::Beam,
-        uj::Kind::Superelement(B1),
-        uj::Kind::Superelement(B2),
-        uj::Kind::Superelement(B3),
-    ] {
+    for kind in uj::MODELS {
         if let Some(x) = r.uj_run(kind, false, rtol) {
             let m = x.tip.max();
             t.row(vec![
@@ -880,12 +863,7 @@ fn uj_section(out: &Path, r: &Results, md: &mut String, figs: &mut Figures) -> R
             &format!("Universal joint: tip {name} in the joint frame"),
             &format!("{name} (m)"),
         );
-        for kind in [
-            uj::Kind::Beam,
-            uj::Kind::Superelement(B1),
-            uj::Kind::Superelement(B2),
-            uj::Kind::Superelement(B3),
-        ] {
+        for kind in uj::MODELS {
             if let Some(x) = r.uj_run(kind, false, rtol) {
                 let y = x.tip.d.iter().map(|d| d[k]).collect();
                 fig.add(&kind.label(), &x.tip.t, y, kind != uj::Kind::Beam);

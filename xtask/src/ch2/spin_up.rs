@@ -58,6 +58,15 @@ impl Kind {
     }
 }
 
+/// The models of Table 2.1, in the order of the report.
+pub const TABLE_MODELS: [Kind; 5] = [
+    Kind::Beam { shortening: false },
+    Kind::Beam { shortening: true },
+    Kind::Superelement(VelocityTransform::B1),
+    Kind::Superelement(VelocityTransform::B2),
+    Kind::Superelement(VelocityTransform::B3),
+];
+
 /// The planar beam scene with `n` beams.
 pub fn beam_scene(n: usize, shortening: bool) -> String {
     format!(

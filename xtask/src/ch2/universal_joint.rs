@@ -52,6 +52,14 @@ impl Kind {
     }
 }
 
+/// The models compared, in the order of the report.
+pub const MODELS: [Kind; 4] = [
+    Kind::Beam,
+    Kind::Superelement(VelocityTransform::B1),
+    Kind::Superelement(VelocityTransform::B2),
+    Kind::Superelement(VelocityTransform::B3),
+];
+
 /// The scene with `N` elements; superelements of the file `file` (built
 /// with p → q along +x, or along −x when `reversed`). `reversed` lists each
 /// element's nodes outer end first.
