@@ -153,3 +153,21 @@ pub enum DynamicsError {
     #[error("stopped on request")]
     Interrupted,
 }
+
+impl DynamicsError {
+    /// For an [`Integration`](Self::Integration) error that an evaluation of
+    /// the equations of motion ended (the integrator's
+    /// [`OdeError::Rhs`](flexmb_ode::OdeError::Rhs)): that evaluation's own
+    /// error, typed (e.g. a [`Kinematics`](Self::Kinematics) failure with
+    /// its [`KinematicsError`](flexmb_kinematics::KinematicsError)). `None` for other errors, and for an
+    /// integration that ended for another reason (a step-size underflow).
+    pub fn failed_evaluation(&self) -> Option<&DynamicsError> {
+        match self {
+            Self::Integration {
+                source: flexmb_ode::OdeError::Rhs { source, .. },
+                ..
+            } => source.downcast_cause::<DynamicsError>(),
+            _ => None,
+        }
+    }
+}

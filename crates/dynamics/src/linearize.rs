@@ -333,13 +333,7 @@ impl Dynamics {
         q: &[f64],
         stop: Option<&AtomicBool>,
     ) -> Result<Linearization, DynamicsError> {
-        let check = || {
-            if crate::simulate::stop_requested(stop) {
-                Err(DynamicsError::Interrupted)
-            } else {
-                Ok(())
-            }
-        };
+        let check = || crate::simulate::check_stop(stop);
         let n_q = self.mech.n_dof();
         check()?;
         self.kinematics_at(t, q, Some(&vec![0.0; n_q]))?;

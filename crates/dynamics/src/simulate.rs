@@ -8,7 +8,7 @@ use faer::Mat;
 use flexmb_model::{ChartSwitch, Coordinate, EulerChart, Mechanism};
 use flexmb_ode::{
     Adams, AdamsOptions, Control, Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions,
-    OdeSystem, Output, RhsError, SecondOrderSystem, Stats, Tolerance,
+    OdeSystem, Output, RhsError, RhsErrorKind, SecondOrderSystem, Stats, Tolerance,
 };
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -88,6 +88,16 @@ impl SimulationOptions {
 /// True if `stop` is given and set: a stop was requested.
 pub(crate) fn stop_requested(stop: Option<&AtomicBool>) -> bool {
     stop.is_some_and(|s| s.load(Ordering::Relaxed))
+}
+
+/// [`DynamicsError::Interrupted`] if a stop was requested: the check
+/// between the parts of a long evaluation.
+pub(crate) fn check_stop(stop: Option<&AtomicBool>) -> Result<(), DynamicsError> {
+    if stop_requested(stop) {
+        Err(DynamicsError::Interrupted)
+    } else {
+        Ok(())
+    }
 }
 
 /// A computed trajectory.
@@ -325,13 +335,19 @@ fn integrate_explicit_named<S: OdeSystem + ?Sized>(
 
 /// Kinematic failures at a trial state are recoverable (a smaller step
 /// reaches a solvable configuration); the others abort the integration.
+/// The integrator's view of a failed evaluation: a kinematics failure or a
+/// non-finite value may be avoided by a smaller step, a stop request ends
+/// the run cleanly, anything else is fatal. The typed error is kept as the
+/// cause ([`DynamicsError::failed_evaluation`]).
 fn to_rhs_error(e: DynamicsError) -> RhsError {
-    match e {
+    let kind = match e {
         DynamicsError::Kinematics { .. } | DynamicsError::NonFinite { .. } => {
-            RhsError::recoverable(e.to_string())
+            RhsErrorKind::Recoverable
         }
-        _ => RhsError::new(e.to_string()),
-    }
+        DynamicsError::Interrupted => RhsErrorKind::Interrupted,
+        _ => RhsErrorKind::Fatal,
+    };
+    RhsError::from_cause(kind, e)
 }
 
 /// Values of the DOFs (or their rates).
@@ -475,7 +491,7 @@ impl SecondOrderSystem for Residual<'_> {
     ) -> Result<(), RhsError> {
         let (m, d, k) = self
             .dy
-            .tangent_matrices(t, q, qd, qdd)
+            .tangent_matrices_until(t, q, qd, qdd, self.stop)
             .map_err(|e| self.watch.failed(t, e))?;
         mass.copy_from(&m);
         damping.copy_from(&d);
@@ -518,9 +534,30 @@ impl Dynamics {
         qd: &[f64],
         qdd: &[f64],
     ) -> Result<TangentMatrices, DynamicsError> {
+        self.tangent_matrices_until(t, q, qd, qdd, None)
+    }
+
+    /// [`tangent_matrices`](Self::tangent_matrices) that ends with
+    /// [`DynamicsError::Interrupted`] when `stop` is set: it is read between
+    /// the position solve and the assembly of each matrix, and inside that of
+    /// the geometric stiffness, as in
+    /// [`linearize_at_rest_until`](Self::linearize_at_rest_until). A
+    /// generalized-α run of a large model reads its stop request here.
+    pub fn tangent_matrices_until(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        stop: Option<&AtomicBool>,
+    ) -> Result<TangentMatrices, DynamicsError> {
+        let check = || check_stop(stop);
+        check()?;
         self.kinematics_at(t, q, Some(qd))?;
+        check()?;
         self.forces(t, true);
         self.inertia(true);
+        check()?;
         let n_q = self.n_q();
         let mq = self.mq.clone();
         // w' = Mx ẍ − f = −w + Mx F,q q̈
@@ -534,9 +571,14 @@ impl Dynamics {
         let mut wq: Vec<f64> = self.w.iter().map(|v| -v).collect();
         self.mass_times_add(&xdd_q, &mut wq);
         let sigma = self.sigma.clone();
-        let mut k = self.kin.second_order_contraction(&wq, &sigma);
+        let mut k = self
+            .kin
+            .second_order_contraction_until(&wq, &sigma, stop)
+            .ok_or(DynamicsError::Interrupted)?;
+        check()?;
         k += &self.structural_stiffness();
         k -= &self.load_stiffness(t);
+        check()?;
         let d = self.damping_matrix();
         Ok((mq, d, k))
     }

@@ -6,10 +6,9 @@ use flexmb_dynamics::{Control, Dynamics, DynamicsError, Integrator, SimulationOp
 use flexmb_model::Scene;
 use std::sync::Arc;
 
-#[test]
-fn a_mechanism_driven_out_of_reach_names_the_failing_equations() {
-    // two bars of 1 m that keep their length, the free end driven in x from 1.6 m to 2.5 m:
-    // out of reach once x > 2 m (at t = 0.44 s)
+/// Two bars of 1 m that keep their length, the free end driven in x from
+/// 1.6 m to 2.5 m: out of reach once x > 2 m (at t = 0.44 s).
+fn out_of_reach() -> Arc<flexmb_model::Mechanism> {
     let scene = Scene::from_ron_str(
         r#"(
         dimension: Planar,
@@ -28,7 +27,52 @@ fn a_mechanism_driven_out_of_reach_names_the_failing_equations() {
     )"#,
     )
     .unwrap();
-    let mech = Arc::new(scene.build(None).unwrap());
+    Arc::new(scene.build(None).unwrap())
+}
+
+#[test]
+fn an_evaluation_that_fails_keeps_its_typed_error_for_the_integrator() {
+    // with a fixed step nothing is retried: the integrator ends with the
+    // evaluation's failure, the kinematics error kept as its cause
+    let mech = out_of_reach();
+    let mut dy = Dynamics::new(mech.clone());
+    let mut y0 = mech.q0();
+    y0.extend(vec![0.0; mech.n_dof()]);
+    let method = flexmb_ode::Dopri5::new(flexmb_ode::Dopri5Options::default().fixed_step(0.05));
+    let err = method
+        .solve(
+            &mut dy.first_order_system(),
+            0.0,
+            &y0,
+            1.0,
+            &flexmb_ode::Output::Final,
+        )
+        .expect_err("the end is driven out of reach");
+    let flexmb_ode::OdeError::Rhs { t, source } = &err else {
+        panic!("not an evaluation failure: {err:?}");
+    };
+    assert!(*t > 0.0 && *t < 1.0, "failed at t = {t}");
+    assert!(source.is_recoverable());
+    let cause = source.downcast_cause::<DynamicsError>();
+    assert!(
+        matches!(cause, Some(DynamicsError::Kinematics { .. })),
+        "{cause:?}"
+    );
+    assert_eq!(source.message(), cause.unwrap().to_string());
+    // and through a DynamicsError::Integration
+    let wrapped = DynamicsError::Integration {
+        source: err.clone(),
+        message: err.to_string(),
+    };
+    assert_eq!(wrapped.failed_evaluation(), cause);
+    assert_eq!(DynamicsError::Interrupted.failed_evaluation(), None);
+}
+
+#[test]
+fn a_mechanism_driven_out_of_reach_names_the_failing_equations() {
+    // two bars of 1 m that keep their length, the free end driven in x from 1.6 m to 2.5 m:
+    // out of reach once x > 2 m (at t = 0.44 s)
+    let mech = out_of_reach();
 
     for integrator in [
         Integrator::Dopri5,

@@ -53,6 +53,10 @@ pub(crate) struct JacobianLu {
     factored: bool,
     /// Smallest |Uᵢᵢ| / largest |Uᵢᵢ| of the last factorization (0 when it failed).
     pub(crate) pivot_ratio: f64,
+    /// The column of A whose pivot was the smallest in the last sparse
+    /// factorization, when it ran to the end (`None` otherwise, and on the
+    /// dense path).
+    smallest_pivot_column: Option<usize>,
 }
 
 impl std::fmt::Debug for JacobianLu {
@@ -135,6 +139,7 @@ impl JacobianLu {
             }),
             factored: false,
             pivot_ratio: 0.0,
+            smallest_pivot_column: None,
         };
         (lu, positions)
     }
@@ -150,6 +155,14 @@ impl JacobianLu {
     /// before [`factor`](Self::factor).
     pub(crate) fn values_mut(&mut self) -> &mut [f64] {
         &mut self.values
+    }
+
+    /// The column whose pivot was the smallest in the last factorization,
+    /// if it was sparse and ran to the end: the coordinate a (nearly)
+    /// singular J leaves least determined, found without the O(n³) work of a
+    /// null space.
+    pub(crate) fn smallest_pivot_column(&self) -> Option<usize> {
+        self.smallest_pivot_column
     }
 
     /// The matrix as a dense one (for diagnostics of a singular Jacobian).
@@ -168,6 +181,7 @@ impl JacobianLu {
     pub(crate) fn factor(&mut self) -> bool {
         self.factored = false;
         self.pivot_ratio = 0.0;
+        self.smallest_pivot_column = None;
         let n = self.n;
         if n == 0 {
             self.factored = true;
@@ -215,15 +229,19 @@ impl JacobianLu {
         if ok.is_err() {
             return false;
         }
-        // U's pivot is the last stored entry of each of its columns
+        // U's pivot is the last stored entry of each of its columns; column j
+        // of U is column `col_perm_fwd[j]` of A (A Q = Pᵀ L U)
         let u = self.lu.u_factor_unsorted();
-        let (mut mn, mut mx) = (f64::INFINITY, 0.0f64);
+        let (mut mn, mut mx, mut j_min) = (f64::INFINITY, 0.0f64, 0);
         for j in 0..n {
             let vals = u.val_of_col(j);
             let d = vals.last().map_or(0.0, |v| v.abs());
-            mn = mn.min(d);
+            if d < mn {
+                (mn, j_min) = (d, j);
+            }
             mx = mx.max(d);
         }
+        self.smallest_pivot_column = Some(self.col_perm_fwd[j_min]);
         self.pivot_ratio = if mx > 0.0 && mx.is_finite() {
             mn / mx
         } else {
@@ -363,6 +381,53 @@ mod tests {
         lu.solve_transpose_in_place(y.as_mut());
         let r = dense.transpose() * &y - &b;
         assert!(r.norm_max() < 1e-12, "transpose residual {}", r.norm_max());
+    }
+
+    /// A column scaled by 1e-20 scales its pivot alike: the sparse
+    /// factorization names it, through its row and column permutations.
+    #[test]
+    fn the_smallest_pivot_names_a_nearly_zero_column() {
+        let n = 30;
+        let mut seed = 11u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let mut entries = vec![];
+        let mut vals = vec![];
+        for i in 0..n {
+            entries.push((i, (i * 7) % n));
+            vals.push(3.0 + rnd());
+            for _ in 0..3 {
+                let j = ((rnd() + 0.5) * n as f64) as usize % n;
+                entries.push((i, j));
+                vals.push(rnd());
+            }
+        }
+        for tiny in [4, 17, 29] {
+            let (mut lu, pos) = JacobianLu::with_dense_limit(n, &entries, 0);
+            lu.values_mut().fill(0.0);
+            for ((p, v), (_, c)) in pos.iter().zip(&vals).zip(&entries) {
+                lu.values_mut()[*p] += if *c == tiny { 1e-20 * v } else { *v };
+            }
+            assert!(!lu.factor());
+            assert!(lu.pivot_ratio < SINGULAR_PIVOT_RATIO);
+            assert_eq!(lu.smallest_pivot_column(), Some(tiny));
+            assert_ne!(
+                lu.col_perm_fwd,
+                (0..n).collect::<Vec<_>>(),
+                "no column permutation"
+            );
+        }
+        // the dense path leaves it to the caller
+        let (mut lu, pos) = JacobianLu::with_dense_limit(n, &entries, usize::MAX);
+        for (p, v) in pos.iter().zip(&vals) {
+            lu.values_mut()[*p] += v;
+        }
+        assert!(lu.factor());
+        assert_eq!(lu.smallest_pivot_column(), None);
     }
 
     #[test]

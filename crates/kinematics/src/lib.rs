@@ -600,8 +600,34 @@ impl Kinematics {
         }
     }
 
+    /// The error for a singular J, naming the dependent coordinates it
+    /// leaves undetermined. A failed factorization is often recoverable (an
+    /// iterate far from the solution; the integrator retries with a smaller
+    /// step), so this must stay cheap: the null vector by a dense SVD only
+    /// for a Jacobian small enough to be factorized densely (at most
+    /// `DENSE_UP_TO` rows, milliseconds); for a large one the coordinate of
+    /// the sparse factorization's smallest pivot (the SVD of the 1680 × 1680
+    /// J of the 1440-DOF flexure chain took 4 s, at every failed iterate of
+    /// a time step).
     fn singular_error(&self) -> KinematicsError {
-        // null space of J by SVD names the undetermined coordinates
+        let n = self.mech.dependent.len();
+        let names = if n <= DENSE_UP_TO {
+            self.null_space_names()
+        } else {
+            self.lu
+                .smallest_pivot_column()
+                .map(|c| vec![self.mech.x_names[self.mech.dependent[c]].clone()])
+                .unwrap_or_default()
+        };
+        KinematicsError::Singular {
+            pivot_ratio: self.lu.pivot_ratio,
+            coordinates: names,
+        }
+    }
+
+    /// The dependent coordinates with a large share in J's null vector (its
+    /// smallest singular value's right singular vector).
+    fn null_space_names(&self) -> Vec<String> {
         let mut names = vec![];
         if let Ok(svd) = flexmb_linalg::svd(self.lu.to_dense().as_ref()) {
             let n = svd.s.len();
@@ -616,10 +642,7 @@ impl Kinematics {
                 }
             }
         }
-        KinematicsError::Singular {
-            pivot_ratio: self.lu.pivot_ratio,
-            coordinates: names,
-        }
+        names
     }
 
     /// Solves the configuration for degrees of freedom `q` at time `t`

@@ -1,17 +1,38 @@
 //! Error types: failures reported by user systems and by the integrators.
 
 use std::fmt;
+use std::sync::Arc;
 
 /// Failure reported by a user-supplied right-hand side, residual or tangent.
 ///
 /// The mechanics layer uses it, for instance, to report that the Newton
-/// solve for a constrained configuration did not converge. It only carries a
-/// human-readable message; the integrator adds the time at which it happened
-/// (see [`OdeError::Rhs`]).
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// solve for a constrained configuration did not converge. It carries a
+/// human-readable message, what the integrator may do about it
+/// ([`RhsErrorKind`]), and optionally the typed error it came from
+/// ([`cause`](Self::cause), [`downcast_cause`](Self::downcast_cause)). The
+/// integrator adds the time at which it happened (see [`OdeError::Rhs`]).
+#[derive(Clone, Debug)]
 pub struct RhsError {
     message: String,
-    recoverable: bool,
+    kind: RhsErrorKind,
+    cause: Option<Arc<dyn std::error::Error + Send + Sync + 'static>>,
+}
+
+/// What an integrator does with an [`RhsError`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RhsErrorKind {
+    /// The integration ends with [`OdeError::Rhs`].
+    Fatal,
+    /// A smaller step may avoid it (e.g. a configuration solve that failed at
+    /// a stage far from the solution): the step is rejected and retried.
+    Recoverable,
+    /// The system was asked to stop in the middle of a long evaluation (a
+    /// tangent of a large model): the integration ends cleanly with
+    /// [`Status::Stopped`](crate::Status::Stopped) at the last accepted time,
+    /// its solution so far kept, as when `step_accepted` stops it. The
+    /// implicit integrator honours it in its tangent; elsewhere it ends the
+    /// integration like [`Fatal`](Self::Fatal).
+    Interrupted,
 }
 
 impl RhsError {
@@ -19,28 +40,79 @@ impl RhsError {
     pub fn new(message: impl Into<String>) -> Self {
         Self {
             message: message.into(),
-            recoverable: false,
+            kind: RhsErrorKind::Fatal,
+            cause: None,
         }
     }
 
     /// Creates an error that a smaller step may avoid (e.g. a configuration
-    /// solve that failed at a stage far from the solution): the explicit
-    /// integrators reject the step and retry with a quarter of the step size.
+    /// solve that failed at a stage far from the solution): the integrators
+    /// reject the step and retry with a smaller step size.
     pub fn recoverable(message: impl Into<String>) -> Self {
         Self {
-            message: message.into(),
-            recoverable: true,
+            kind: RhsErrorKind::Recoverable,
+            ..Self::new(message)
         }
+    }
+
+    /// A stop request honoured inside an evaluation ([`RhsErrorKind::Interrupted`]).
+    pub fn interrupted() -> Self {
+        Self {
+            kind: RhsErrorKind::Interrupted,
+            ..Self::new("stopped on request")
+        }
+    }
+
+    /// The error of kind `kind` for the typed error `cause`: its message is
+    /// the cause's, and the cause is kept for [`downcast_cause`](Self::downcast_cause).
+    pub fn from_cause(
+        kind: RhsErrorKind,
+        cause: impl std::error::Error + Send + Sync + 'static,
+    ) -> Self {
+        Self {
+            message: cause.to_string(),
+            kind,
+            cause: Some(Arc::new(cause)),
+        }
+    }
+
+    /// What the integrator does with it.
+    pub fn kind(&self) -> RhsErrorKind {
+        self.kind
     }
 
     /// Whether a smaller step may avoid the error.
     pub fn is_recoverable(&self) -> bool {
-        self.recoverable
+        self.kind == RhsErrorKind::Recoverable
+    }
+
+    /// Whether it is a stop request ([`RhsErrorKind::Interrupted`]).
+    pub fn is_interrupted(&self) -> bool {
+        self.kind == RhsErrorKind::Interrupted
     }
 
     /// The message given at creation.
     pub fn message(&self) -> &str {
         &self.message
+    }
+
+    /// The typed error this one was made from, if any. It is not returned by
+    /// [`std::error::Error::source`]: the message already is its text, and
+    /// a printer of the source chain would repeat it.
+    pub fn cause(&self) -> Option<&(dyn std::error::Error + Send + Sync + 'static)> {
+        self.cause.as_deref()
+    }
+
+    /// The cause as an `E`, if it is one.
+    pub fn downcast_cause<E: std::error::Error + 'static>(&self) -> Option<&E> {
+        self.cause()?.downcast_ref::<E>()
+    }
+}
+
+/// Equal when message and kind are (the causes are not compared).
+impl PartialEq for RhsError {
+    fn eq(&self, other: &Self) -> bool {
+        self.message == other.message && self.kind == other.kind
     }
 }
 
@@ -68,6 +140,12 @@ impl OdeError {
     /// Whether the error is a recoverable failure of the system's evaluation.
     pub fn is_recoverable_rhs(&self) -> bool {
         matches!(self, OdeError::Rhs { source, .. } if source.is_recoverable())
+    }
+
+    /// Whether the error is a stop request honoured inside an evaluation
+    /// ([`RhsErrorKind::Interrupted`]).
+    pub fn is_interrupted_rhs(&self) -> bool {
+        matches!(self, OdeError::Rhs { source, .. } if source.is_interrupted())
     }
 }
 

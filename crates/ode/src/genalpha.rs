@@ -571,205 +571,215 @@ impl GeneralizedAlpha {
         x0.q.copy_from_slice(q0);
         x0.qd.copy_from_slice(qd0);
 
-        // Consistent initial acceleration.
-        match &o.initial_acceleration {
-            Some(a0) => x0.qdd.copy_from_slice(a0),
-            None => {
-                let zeros = &x1.qdd; // all zero at this point
-                eval_tangent(sys, t, &x0.q, &x0.qd, zeros, &mut lin, &mut stats)?;
-                lin.lu.matrix_mut().copy_from(&lin.mass);
-                stats.lu_decompositions += 1;
-                if let Err(source) = lin.lu.factor_in_place() {
-                    return Err(OdeError::SingularMatrix {
-                        what: "mass",
+        // The integration proper. A stop request honoured inside a tangent
+        // evaluation (`RhsErrorKind::Interrupted`, the tangent of a large
+        // model takes long) ends it as a stop between steps does.
+        #[allow(clippy::redundant_closure_call)]
+        let run = (|| -> Result<(), OdeError> {
+            // Consistent initial acceleration.
+            match &o.initial_acceleration {
+                Some(a0) => x0.qdd.copy_from_slice(a0),
+                None => {
+                    let zeros = &x1.qdd; // all zero at this point
+                    eval_tangent(sys, t, &x0.q, &x0.qd, zeros, &mut lin, &mut stats)?;
+                    lin.lu.matrix_mut().copy_from(&lin.mass);
+                    stats.lu_decompositions += 1;
+                    if let Err(source) = lin.lu.factor_in_place() {
+                        return Err(OdeError::SingularMatrix {
+                            what: "mass",
+                            t,
+                            source,
+                        });
+                    }
+                    eval_residual(sys, t, &x0.q, &x0.qd, zeros, &mut r, &mut stats)?;
+                    for (a, ri) in x0.qdd.iter_mut().zip(&r) {
+                        *a = -ri;
+                    }
+                    lin.lu.solve_vec(&mut x0.qdd);
+                    if let Some(index) = first_non_finite(&x0.qdd) {
+                        return Err(OdeError::NonFiniteState { t, index });
+                    }
+                    // The tangent is kept for the first step (evaluated at q̈ = 0).
+                    lin.stale = false;
+                }
+            }
+            x0.a.copy_from_slice(&x0.qdd);
+
+            if sink.initial(t, &x0) == Control::Stop {
+                return Ok(());
+            }
+
+            let mut h = match (o.fixed_step, o.h0) {
+                (Some(hf), _) => hf,
+                (None, Some(h0)) => h0.min(hmax),
+                (None, None) => (0.01 * span).min(hmax),
+            };
+            let mut eta = 1.0f64;
+            let pow = 1.0 / 3.0;
+            // the previous accepted step and its initial acceleration, for the
+            // velocity error estimate
+            let mut h_prev: Option<f64> = None;
+            let mut qdd_prev = vec![0.0; n];
+            let mut err_work = ErrorWork {
+                eq: vec![0.0; n],
+                ev: vec![0.0; n],
+                tmp: vec![0.0; n],
+            };
+
+            loop {
+                if stats.steps_accepted >= o.max_steps {
+                    return Err(OdeError::MaxStepsExceeded {
                         t,
-                        source,
+                        max_steps: o.max_steps,
                     });
                 }
-                eval_residual(sys, t, &x0.q, &x0.qd, zeros, &mut r, &mut stats)?;
-                for (a, ri) in x0.qdd.iter_mut().zip(&r) {
-                    *a = -ri;
-                }
-                lin.lu.solve_vec(&mut x0.qdd);
-                if let Some(index) = first_non_finite(&x0.qdd) {
-                    return Err(OdeError::NonFiniteState { t, index });
-                }
-                // The tangent is kept for the first step (evaluated at q̈ = 0).
-                lin.stale = false;
-            }
-        }
-        x0.a.copy_from_slice(&x0.qdd);
-
-        if sink.initial(t, &x0) == Control::Stop {
-            sink.solution.stats = stats;
-            return Ok(sink.solution);
-        }
-
-        let mut h = match (o.fixed_step, o.h0) {
-            (Some(hf), _) => hf,
-            (None, Some(h0)) => h0.min(hmax),
-            (None, None) => (0.01 * span).min(hmax),
-        };
-        let mut eta = 1.0f64;
-        let pow = 1.0 / 3.0;
-        // the previous accepted step and its initial acceleration, for the
-        // velocity error estimate
-        let mut h_prev: Option<f64> = None;
-        let mut qdd_prev = vec![0.0; n];
-        let mut err_work = ErrorWork {
-            eq: vec![0.0; n],
-            ev: vec![0.0; n],
-            tmp: vec![0.0; n],
-        };
-
-        loop {
-            if stats.steps_accepted >= o.max_steps {
-                return Err(OdeError::MaxStepsExceeded {
-                    t,
-                    max_steps: o.max_steps,
-                });
-            }
-            let remaining = t_end - t;
-            let mut done = false;
-            let stretch = if o.fixed_step.is_some() {
-                1.0 - 1e-9
-            } else {
-                1.0 / 1.1
-            };
-            if h >= remaining * stretch {
-                h = remaining;
-                done = true;
-            }
-            if lin.stale {
-                eval_tangent(sys, t, &x0.q, &x0.qd, &x0.qdd, &mut lin, &mut stats)?;
-                lin.stale = false;
-                lin.fresh = true;
-                lin.h_lu = None;
-            }
-            let mut rejected = false;
-            let (t1, theta_max, err) = loop {
-                if sys.stop_requested() {
-                    sink.solution.status = Status::Stopped { t };
-                    sink.solution.stats = stats;
-                    return Ok(sink.solution);
-                }
-                let h_min = 16.0 * spacing(t);
-                if h < h_min {
-                    return Err(OdeError::StepSizeTooSmall { t, h, h_min });
-                }
-                let t1 = if done { t_end } else { t + h };
-                if lin.h_lu != Some(h) {
-                    build_iteration_matrix(&mut lin, &par, h);
-                    stats.lu_decompositions += 1;
-                    match lin.lu.factor_in_place() {
-                        Ok(_) => lin.h_lu = Some(h),
-                        Err(e) => {
-                            lin.h_lu = None;
-                            lin.lu_error = Some(e);
-                        }
-                    }
-                }
-                let result = if lin.h_lu.is_some() {
-                    newton(
-                        sys, o, &par, &atol, t1, h, &x0, &mut x1, &mut r, &mut dq, &mut lin,
-                        &mut eta, &mut stats,
-                    )?
+                let remaining = t_end - t;
+                let mut done = false;
+                let stretch = if o.fixed_step.is_some() {
+                    1.0 - 1e-9
                 } else {
-                    Newton::Singular
+                    1.0 / 1.1
                 };
-                match result {
-                    Newton::Converged { theta_max } => {
-                        if o.fixed_step.is_some() {
-                            break (t1, theta_max, 0.0);
-                        }
-                        let err = local_error_norm(
-                            &par,
-                            h,
-                            h_prev.map(|hp| (hp, qdd_prev.as_slice())),
-                            &x0,
-                            &x1,
-                            &mut lin,
-                            &mut err_work,
-                            &atol,
-                            o.rtol,
-                        );
-                        if err <= 1.0 {
-                            break (t1, theta_max, err);
-                        }
-                        stats.steps_rejected += 1;
-                        rejected = true;
-                        h *= (0.9 * err.powf(-pow)).max(0.2);
-                        done = false;
-                        if theta_max > o.jacobian_refresh && !lin.fresh {
-                            eval_tangent(sys, t, &x0.q, &x0.qd, &x0.qdd, &mut lin, &mut stats)?;
-                            lin.fresh = true;
-                            lin.h_lu = None;
+                if h >= remaining * stretch {
+                    h = remaining;
+                    done = true;
+                }
+                if lin.stale {
+                    eval_tangent(sys, t, &x0.q, &x0.qd, &x0.qdd, &mut lin, &mut stats)?;
+                    lin.stale = false;
+                    lin.fresh = true;
+                    lin.h_lu = None;
+                }
+                let mut rejected = false;
+                let (t1, theta_max, err) = loop {
+                    if sys.stop_requested() {
+                        sink.solution.status = Status::Stopped { t };
+                        return Ok(());
+                    }
+                    let h_min = 16.0 * spacing(t);
+                    if h < h_min {
+                        return Err(OdeError::StepSizeTooSmall { t, h, h_min });
+                    }
+                    let t1 = if done { t_end } else { t + h };
+                    if lin.h_lu != Some(h) {
+                        build_iteration_matrix(&mut lin, &par, h);
+                        stats.lu_decompositions += 1;
+                        match lin.lu.factor_in_place() {
+                            Ok(_) => lin.h_lu = Some(h),
+                            Err(e) => {
+                                lin.h_lu = None;
+                                lin.lu_error = Some(e);
+                            }
                         }
                     }
-                    Newton::Failed | Newton::Singular => {
-                        let singular = matches!(result, Newton::Singular);
-                        stats.newton_failures += usize::from(!singular);
-                        if !lin.fresh {
-                            eval_tangent(sys, t, &x0.q, &x0.qd, &x0.qdd, &mut lin, &mut stats)?;
-                            lin.fresh = true;
-                            lin.h_lu = None;
-                        } else if o.fixed_step.is_some() {
-                            return Err(if singular {
-                                OdeError::SingularMatrix {
-                                    what: "iteration",
-                                    t,
-                                    source: lin.lu_error.unwrap_or(LuError::Singular {
-                                        n: x0.q.len(),
-                                        index: 0,
-                                        pivot_ratio: 0.0,
-                                        threshold: 0.0,
-                                    }),
-                                }
-                            } else {
-                                OdeError::NewtonFailed { t, h }
-                            });
-                        } else {
+                    let result = if lin.h_lu.is_some() {
+                        newton(
+                            sys, o, &par, &atol, t1, h, &x0, &mut x1, &mut r, &mut dq, &mut lin,
+                            &mut eta, &mut stats,
+                        )?
+                    } else {
+                        Newton::Singular
+                    };
+                    match result {
+                        Newton::Converged { theta_max } => {
+                            if o.fixed_step.is_some() {
+                                break (t1, theta_max, 0.0);
+                            }
+                            let err = local_error_norm(
+                                &par,
+                                h,
+                                h_prev.map(|hp| (hp, qdd_prev.as_slice())),
+                                &x0,
+                                &x1,
+                                &mut lin,
+                                &mut err_work,
+                                &atol,
+                                o.rtol,
+                            );
+                            if err <= 1.0 {
+                                break (t1, theta_max, err);
+                            }
+                            stats.steps_rejected += 1;
                             rejected = true;
-                            h *= 0.5;
+                            h *= (0.9 * err.powf(-pow)).max(0.2);
                             done = false;
+                            if theta_max > o.jacobian_refresh && !lin.fresh {
+                                eval_tangent(sys, t, &x0.q, &x0.qd, &x0.qdd, &mut lin, &mut stats)?;
+                                lin.fresh = true;
+                                lin.h_lu = None;
+                            }
                         }
-                        eta = 1.0;
+                        Newton::Failed | Newton::Singular => {
+                            let singular = matches!(result, Newton::Singular);
+                            stats.newton_failures += usize::from(!singular);
+                            if !lin.fresh {
+                                eval_tangent(sys, t, &x0.q, &x0.qd, &x0.qdd, &mut lin, &mut stats)?;
+                                lin.fresh = true;
+                                lin.h_lu = None;
+                            } else if o.fixed_step.is_some() {
+                                return Err(if singular {
+                                    OdeError::SingularMatrix {
+                                        what: "iteration",
+                                        t,
+                                        source: lin.lu_error.unwrap_or(LuError::Singular {
+                                            n: x0.q.len(),
+                                            index: 0,
+                                            pivot_ratio: 0.0,
+                                            threshold: 0.0,
+                                        }),
+                                    }
+                                } else {
+                                    OdeError::NewtonFailed { t, h }
+                                });
+                            } else {
+                                rejected = true;
+                                h *= 0.5;
+                                done = false;
+                            }
+                            eta = 1.0;
+                        }
                     }
-                }
-            };
-
-            let h_taken = t1 - t;
-            stats.record_accepted(h_taken);
-            let control = sink.step(t, t1, &x0, &x1, done);
-            qdd_prev.copy_from_slice(&x0.qdd);
-            h_prev = Some(h_taken);
-            std::mem::swap(&mut x0, &mut x1);
-            t = t1;
-            lin.fresh = false;
-            if theta_max > o.jacobian_refresh {
-                lin.stale = true;
-            }
-            if done || control == Control::Stop {
-                break;
-            }
-            if sys.step_accepted(t, &x0.q, &x0.qd) == Control::Stop {
-                sink.solution.status = Status::Stopped { t };
-                break;
-            }
-            if o.fixed_step.is_none() {
-                let mut factor = if err > 0.0 {
-                    (0.9 * err.powf(-pow)).clamp(0.2, 5.0)
-                } else {
-                    5.0
                 };
-                if rejected {
-                    factor = factor.min(1.0);
+
+                let h_taken = t1 - t;
+                stats.record_accepted(h_taken);
+                let control = sink.step(t, t1, &x0, &x1, done);
+                qdd_prev.copy_from_slice(&x0.qdd);
+                h_prev = Some(h_taken);
+                std::mem::swap(&mut x0, &mut x1);
+                t = t1;
+                lin.fresh = false;
+                if theta_max > o.jacobian_refresh {
+                    lin.stale = true;
                 }
-                if (1.0..1.2).contains(&factor) {
-                    factor = 1.0;
+                if done || control == Control::Stop {
+                    break;
                 }
-                h = (h_taken * factor).min(hmax);
+                if sys.step_accepted(t, &x0.q, &x0.qd) == Control::Stop {
+                    sink.solution.status = Status::Stopped { t };
+                    break;
+                }
+                if o.fixed_step.is_none() {
+                    let mut factor = if err > 0.0 {
+                        (0.9 * err.powf(-pow)).clamp(0.2, 5.0)
+                    } else {
+                        5.0
+                    };
+                    if rejected {
+                        factor = factor.min(1.0);
+                    }
+                    if (1.0..1.2).contains(&factor) {
+                        factor = 1.0;
+                    }
+                    h = (h_taken * factor).min(hmax);
+                }
             }
+            Ok(())
+        })();
+        match run {
+            Ok(()) => {}
+            Err(e) if e.is_interrupted_rhs() => sink.solution.status = Status::Stopped { t },
+            Err(e) => return Err(e),
         }
         sink.solution.stats = stats;
         Ok(sink.solution)

@@ -72,7 +72,7 @@ mod system;
 pub use adams::{Adams, AdamsOptions};
 pub use common::{Control, Output, Solution, Stats, Status, Tolerance};
 pub use dopri5::{Dopri5, Dopri5Options};
-pub use error::{OdeError, RhsError};
+pub use error::{OdeError, RhsError, RhsErrorKind};
 pub use genalpha::{
     AlphaParameters, GeneralizedAlpha, GeneralizedAlphaOptions, SecondOrderSolution,
 };

@@ -565,3 +565,118 @@ fn generalized_alpha_retries_steps_whose_iterates_cannot_be_evaluated() {
         "q(10) = {q} (unobstructed {q_ref}, exact {exact})"
     );
 }
+
+/// A damped oscillator whose tangent is interrupted at its `stop_at`-th
+/// evaluation, as a large model's tangent honours a stop request.
+struct InterruptedTangent {
+    tangents: usize,
+    stop_at: usize,
+}
+
+impl SecondOrderSystem for InterruptedTangent {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn residual(
+        &mut self,
+        _t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        r: &mut [f64],
+    ) -> Result<(), RhsError> {
+        r[0] = qdd[0] + 0.1 * qd[0] + q[0] + 10.0 * q[0].powi(3);
+        Ok(())
+    }
+    fn tangent(
+        &mut self,
+        _t: f64,
+        q: &[f64],
+        _qd: &[f64],
+        _qdd: &[f64],
+        m: &mut Mat<f64>,
+        c: &mut Mat<f64>,
+        k: &mut Mat<f64>,
+    ) -> Result<(), RhsError> {
+        self.tangents += 1;
+        if self.tangents == self.stop_at {
+            return Err(RhsError::interrupted());
+        }
+        m[(0, 0)] = 1.0;
+        c[(0, 0)] = 0.1;
+        k[(0, 0)] = 1.0 + 30.0 * q[0] * q[0];
+        Ok(())
+    }
+}
+
+#[test]
+fn a_tangent_interrupted_by_a_stop_request_ends_the_run_cleanly_with_the_steps_so_far() {
+    // a tangent at nearly every step (refresh above a contraction of 1e-6)
+    let method = GeneralizedAlpha::new(GeneralizedAlphaOptions {
+        jacobian_refresh: 1e-6,
+        ..GeneralizedAlphaOptions::default().rtol(1e-6)
+    });
+    // the whole run, to know how many tangents it takes
+    let mut full = InterruptedTangent {
+        tangents: 0,
+        stop_at: usize::MAX,
+    };
+    let whole = method
+        .solve(&mut full, 0.0, &[1.0], &[0.0], 20.0, &Output::Steps)
+        .unwrap();
+    assert!(full.tangents >= 4, "{} tangents", full.tangents);
+    let stop_at = full.tangents / 2 + 1;
+    let mut sys = InterruptedTangent {
+        tangents: 0,
+        stop_at,
+    };
+    let sol = method
+        .solve(&mut sys, 0.0, &[1.0], &[0.0], 20.0, &Output::Steps)
+        .expect("an interruption is not an error");
+    let Status::Stopped { t } = sol.status else {
+        panic!("not stopped: {:?}", sol.status);
+    };
+    assert!(t > 0.0 && t < 20.0, "stopped at {t}");
+    assert_eq!(sys.tangents, stop_at, "evaluated on after the interruption");
+    // the steps so far are those of the uninterrupted run, up to the stop
+    let k = sol.len();
+    assert!(k >= 2 && k < whole.len(), "{k} of {} points", whole.len());
+    assert_eq!(sol.t()[k - 1], t);
+    for i in 0..k {
+        assert_eq!(sol.t()[i], whole.t()[i]);
+        assert_eq!(sol.q(i), whole.q(i));
+    }
+    // a fatal tangent error is still an error
+    let mut fatal = Faulty { fail: true };
+    assert!(matches!(
+        method.solve(
+            &mut fatal,
+            0.0,
+            &[1.0, 0.0, 0.0],
+            &[0.0; 3],
+            1.0,
+            &Output::Steps
+        ),
+        Err(OdeError::Rhs { .. })
+    ));
+}
+
+#[test]
+fn an_rhs_error_keeps_its_typed_cause() {
+    #[derive(Debug, PartialEq)]
+    struct Unreachable(usize);
+    impl std::fmt::Display for Unreachable {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            write!(f, "node {} out of reach", self.0)
+        }
+    }
+    impl std::error::Error for Unreachable {}
+    let e = RhsError::from_cause(flexmb_ode::RhsErrorKind::Recoverable, Unreachable(3));
+    assert!(e.is_recoverable() && !e.is_interrupted());
+    assert_eq!(e.message(), "node 3 out of reach");
+    assert_eq!(e.downcast_cause::<Unreachable>(), Some(&Unreachable(3)));
+    assert!(e.downcast_cause::<std::fmt::Error>().is_none());
+    // the message already is the cause's text: no repetition in a source chain
+    assert!(std::error::Error::source(&e).is_none());
+    assert!(RhsError::new("x").cause().is_none());
+}
