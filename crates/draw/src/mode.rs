@@ -19,6 +19,10 @@ pub struct Configuration {
     pub q: Vec<f64>,
     /// The nodal coordinates x = F(q).
     pub x: Vec<f64>,
+    /// The time at which inputs and loads are evaluated.
+    pub t: f64,
+    /// The scale of the nodal loads ([`Dynamics::set_load_scale`]).
+    pub load_scale: f64,
 }
 
 fn compute(e: impl std::fmt::Display) -> DrawError {
@@ -43,6 +47,8 @@ impl Configuration {
             mechanism: mech.clone(),
             q: q.to_vec(),
             x: kin.x().to_vec(),
+            t: 0.0,
+            load_scale: 1.0,
         })
     }
 
@@ -54,14 +60,32 @@ impl Configuration {
     /// The static equilibrium under the scene's loads and gravity at t = 0
     /// (as `flexmb static` and `flexmb eig --static-first` find it).
     pub fn static_equilibrium(mech: &Arc<Mechanism>) -> Result<Configuration, DrawError> {
+        Configuration::loaded(mech, 0.0, 1.0, 1)
+    }
+
+    /// The static equilibrium under the scene's loads at time `t` scaled by
+    /// `load_scale`, and gravity, reached in `load_steps` equal increments.
+    pub fn loaded(
+        mech: &Arc<Mechanism>,
+        t: f64,
+        load_scale: f64,
+        load_steps: usize,
+    ) -> Result<Configuration, DrawError> {
         let mut dy = Dynamics::new(mech.clone());
+        dy.set_load_scale(load_scale);
+        let opts = StaticOptions {
+            load_steps,
+            ..Default::default()
+        };
         let sol = dy
-            .static_equilibrium(0.0, &mech.q0(), &StaticOptions::default())
+            .static_equilibrium(t, &mech.q0(), &opts)
             .map_err(compute)?;
         Ok(Configuration {
             mechanism: dy.mechanism().clone(),
             q: sol.q,
             x: sol.x,
+            t,
+            load_scale,
         })
     }
 }
@@ -93,20 +117,21 @@ pub fn check_mode(mech: &Mechanism, number: usize) -> Result<(), DrawError> {
 }
 
 /// Mode `number` (from 1) of the rest linearization (thesis (E.6)) at
-/// `at`. A number beyond the degrees of freedom is an input error that
+/// `at` (its time and load scale). A number beyond the degrees of freedom is an input error that
 /// says how many modes there are.
 pub fn mode_shape(at: &Configuration, number: usize) -> Result<ModeShape, DrawError> {
     let mech = &at.mechanism;
     check_mode(mech, number)?;
     let n = mech.n_dof();
     let mut dy = Dynamics::new(mech.clone());
-    let lin = dy.linearize_at_rest(0.0, &at.q).map_err(compute)?;
+    dy.set_load_scale(at.load_scale);
+    let lin = dy.linearize_at_rest(at.t, &at.q).map_err(compute)?;
     let modes = flexmb_linearize::undamped_modes(&lin, number).map_err(compute)?;
     let k = number - 1;
     let v: Vec<f64> = (0..n).map(|i| modes.vectors[(i, k)]).collect();
     let mut kin = Kinematics::new(mech.clone());
     kin.set_guess(&at.x);
-    kin.solve(&at.q, 0.0).map_err(compute)?;
+    kin.solve(&at.q, at.t).map_err(compute)?;
     let f = kin.f_xi();
     let mut dx = vec![0.0; f.nrows()];
     for (c, vc) in v.iter().enumerate() {

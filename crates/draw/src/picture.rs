@@ -24,8 +24,8 @@ pub struct DrawOptions {
     /// Phases of the mode drawn, from +amplitude to −amplitude in equal
     /// steps [default: 1, +amplitude only].
     pub phases: Option<usize>,
-    /// The title [default: the mechanism's name, and the mode with its
-    /// frequency].
+    /// The title [default: the mechanism's name]; a mode's number,
+    /// frequency and amplitude follow it.
     pub title: Option<String>,
 }
 
@@ -167,15 +167,13 @@ pub fn picture(at: &Configuration, opts: &DrawOptions) -> Result<Picture, DrawEr
             geometry: geometry(mech, &x, view),
         });
     }
-    let title = opts.title.clone().unwrap_or_else(|| {
-        format!(
-            "{}: mode {k}, {} Hz (amplitude {:.3} m, {:.0} % of the size)",
-            mech.name,
-            significant(shape.frequency_hz),
-            amplitude,
-            100.0 * amplitude / size.max(f64::MIN_POSITIVE)
-        )
-    });
+    let title = format!(
+        "{}: mode {k}, {} Hz (amplitude {:.3} m, {:.0} % of the size)",
+        opts.title.as_deref().unwrap_or(&mech.name),
+        significant(shape.frequency_hz),
+        amplitude,
+        100.0 * amplitude / size.max(f64::MIN_POSITIVE)
+    );
     Ok(Picture {
         title,
         view,
