@@ -2,7 +2,7 @@
 //! pictures saved as SVG and PNG next to the other figures.
 
 use crate::report::Figures;
-use flexmb_draw::{picture, Configuration, DrawOptions, View};
+use flexmb_draw::{picture, Configuration, DrawOptions};
 use std::io;
 use std::path::Path;
 
@@ -34,34 +34,34 @@ pub fn equilibrium(
     Configuration::loaded(mech, t, load_scale, 4).map_err(io_err)
 }
 
-/// The spatial guidance of chapter 6: at its maximum deflection with the
-/// reference configuration overlaid (thesis Fig. 6.5), and modes 1–4 at
-/// x = 0 and at x max (two phases, ±10 % of its size), all isometric.
+/// A straight guidance (chapters 5 and 6) in its default view: at its
+/// maximal deflection (load scale `lambda_max` at `t`) with the reference
+/// configuration overlaid, titled `title` (thesis Fig. 6.5), and modes
+/// 1..=`modes` at x = 0 and at x max (two phases, ±10 % of its size).
 /// Returns the frequencies drawn, (x = 0, x max) per mode.
-pub fn ch6(
+pub fn guidance(
     figs: &mut Figures,
     out: &Path,
-    setup: &crate::ch6::Setup,
+    mech: &std::sync::Arc<flexmb_model::Mechanism>,
+    (t, lambda_max): (f64, f64),
+    title: &str,
+    modes: usize,
 ) -> io::Result<Vec<(f64, f64)>> {
-    let rest = equilibrium(&setup.def, crate::ch6::T_LOAD, 0.0)?;
-    let max = equilibrium(&setup.def, crate::ch6::T_LOAD, setup.lambda_max)?;
-    let iso = Some(View::Iso);
+    let rest = equilibrium(mech, t, 0.0)?;
+    let max = equilibrium(mech, t, lambda_max)?;
     save(
         figs,
         out,
-        "mech_fig6_5_max_deflection",
+        "mech_max_deflection",
         &max,
         &DrawOptions {
-            view: iso,
             reference: true,
-            title: Some(
-                "Fig. 6.5: the guidance at its maximal deflection (grey: reference)".into(),
-            ),
+            title: Some(title.into()),
             ..Default::default()
         },
     )?;
     let mut freqs = vec![];
-    for k in 1..=4 {
+    for k in 1..=modes {
         let mut f = [0.0; 2];
         let at_x = [(&rest, "x0", "x = 0"), (&max, "xmax", "x max")];
         for (j, (at, tag, name)) in at_x.into_iter().enumerate() {
@@ -71,7 +71,6 @@ pub fn ch6(
                 &format!("mech_mode{k}_{tag}"),
                 at,
                 &DrawOptions {
-                    view: iso,
                     mode: Some(k),
                     phases: Some(2),
                     title: Some(format!("Guidance at {name}")),
@@ -83,4 +82,24 @@ pub fn ch6(
         freqs.push((f[0], f[1]));
     }
     Ok(freqs)
+}
+
+/// The report section of the pictures of [`guidance`]: what they show, the
+/// frequencies drawn, and the figures.
+pub fn section(figs: &Figures, lambda_max: f64, freqs: &[(f64, f64)]) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let _ = writeln!(s, "## The mechanism and its modes\n");
+    let _ = writeln!(s, "Drawn by `flexmb_draw` (as `flexmb draw`): the unreduced model at its static equilibrium under the static x-force at S (and gravity, if the scene has it), at x = 0 (λ = 0) and at x max (λ = {lambda_max:.4}); the modes of its rest linearization there, each at ±10 % of the guidance's size (the lighter line is −). Their frequencies are those of the curves' end points.\n");
+    let mut t = crate::report::Table::new(&["mode", "frequency at x = 0 (Hz)", "at x max (Hz)"]);
+    for (k, (f0, f1)) in freqs.iter().enumerate() {
+        t.row(vec![
+            (k + 1).to_string(),
+            crate::report::sig(*f0),
+            crate::report::sig(*f1),
+        ]);
+    }
+    let _ = writeln!(s, "{}", t.render());
+    let _ = writeln!(s, "{}", figs.markdown(|f| f.starts_with("mech_")));
+    s
 }

@@ -375,7 +375,14 @@ fn write_outputs(
         out,
         "speed_vs_error",
     )?;
-    let mode_freqs = crate::pictures::ch6(&mut figs, out, setup)?;
+    let mode_freqs = crate::pictures::guidance(
+        &mut figs,
+        out,
+        &setup.def,
+        (ch6::T_LOAD, setup.lambda_max),
+        "Fig. 6.5: the guidance at its maximal deflection (grey: reference)",
+        4,
+    )?;
     // report
     let mut s = String::new();
     let _ = writeln!(
@@ -463,14 +470,11 @@ fn write_outputs(
     let _ = writeln!(s, "Errors with respect to the unreduced model integrated with Adams: eigenfrequency errors are the largest relative deviation over the stroke of each retained eigenfrequency (ω1–ω2 or ω1–ω4, compared at equal x-displacement); time-response errors are the RMS and maximum deviation of the x- and z-displacement of S over all outputs, relative to max |x| ({:.4} m) and to the peak-to-peak z ({:.3e} m) of the unreduced response. Wall time is the integration only (one core; the machine ran two jobs at once). \n", x_scale, z_scale);
     let _ = writeln!(s, "{}", speed_vs_error_table(&rows_out));
     let _ = writeln!(s, "{}", figs.markdown(|f| f == "speed_vs_error"));
-    let _ = writeln!(s, "## The mechanism and its modes\n");
-    let _ = writeln!(s, "Drawn by `flexmb_draw` (as `flexmb draw`), isometric: the unreduced model at its static equilibrium under gravity and the static x-force at S, at x = 0 (λ = 0) and at x max (λ = {:.4}); the modes of its rest linearization there, each at ±10 % of the guidance's size (the light line is −). Their frequencies are those of the curves' end points.\n", setup.lambda_max);
-    let mut t = Table::new(&["mode", "frequency at x = 0 (Hz)", "at x max (Hz)"]);
-    for (k, (f0, f1)) in mode_freqs.iter().enumerate() {
-        t.row(vec![(k + 1).to_string(), sig(*f0), sig(*f1)]);
-    }
-    let _ = writeln!(s, "{}", t.render());
-    let _ = writeln!(s, "{}", figs.markdown(|f| f.starts_with("mech_")));
+    let _ = writeln!(
+        s,
+        "{}",
+        crate::pictures::section(&figs, setup.lambda_max, &mode_freqs)
+    );
     let _ = writeln!(s, "## Figures\n");
     let _ = writeln!(
         s,
