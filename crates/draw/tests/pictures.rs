@@ -146,6 +146,11 @@ fn png_and_svg_have_the_laid_out_size_and_show_the_elements() {
     let (x, y) = lay.px(0.0, 0.1).unwrap();
     let i = 3 * (y.round() as usize * lay.width as usize + x.round() as usize);
     assert_eq!(&rgb[i..i + 3], &[0x00, 0x72, 0xb2], "no beam at ({x}, {y})");
+    // the fixed node A carries its own marker colour (#333333), not the
+    // palette's for a second series
+    let (x, y) = lay.px(0.0, 0.0).unwrap();
+    let i = 3 * (y.round() as usize * lay.width as usize + x.round() as usize);
+    assert_eq!(&rgb[i..i + 3], &[0x33, 0x33, 0x33], "no ground marker at A");
     let drawn = rgb.chunks(3).filter(|c| c != &[255, 255, 255]).count();
     assert!(drawn > 1000, "{drawn} pixels drawn");
     // nothing but white at the middle of the empty span between the flexures
