@@ -295,3 +295,66 @@ fn the_default_amplitude_is_a_tenth_of_the_size_and_bad_options_are_refused() {
     .to_string();
     assert!(e.contains("amplitude") && e.contains("-1"), "{e}");
 }
+
+/// The position of node `id` in the configuration `x`.
+fn node_at(mech: &Mechanism, x: &[f64], id: &str) -> [f64; 3] {
+    let k = mech.nodes.iter().position(|n| n.id == id).unwrap();
+    node_positions(mech, x)[k]
+}
+
+/// The items of `kind` of element (or node) `id`.
+fn items_of<'a>(
+    g: &'a flexmb_draw::Geometry,
+    kind: ItemKind,
+    id: &str,
+) -> Vec<&'a flexmb_draw::Item> {
+    g.items
+        .iter()
+        .filter(|i| i.kind == kind && i.id == id)
+        .collect()
+}
+
+#[test]
+fn hinges_masses_and_superelements_are_drawn_at_their_nodes() {
+    // the manipulator: hinges G–O and E1–E2, point masses at E1 and T, G fixed
+    let man = mechanism("manipulator_planar.ron");
+    let x = &man.x0;
+    let g = geometry(&man, x, View::Xy);
+    for (kind, id, node) in [
+        (ItemKind::Hinge, "joint1", "G"),
+        (ItemKind::Hinge, "joint2", "E1"),
+        (ItemKind::PointMass, "m1", "E1"),
+        (ItemKind::PointMass, "m2", "T"),
+        (ItemKind::FixedNode, "G", "G"),
+    ] {
+        let it = items_of(&g, kind, id);
+        assert_eq!(it.len(), 1, "{kind:?} {id}");
+        assert_eq!(it[0].model, vec![node_at(&man, x, node)], "{kind:?} {id}");
+    }
+    // four beams per link, each a segment
+    let beams = g.items.iter().filter(|i| i.kind == ItemKind::Beam).count();
+    assert_eq!(beams, 8);
+    // superelements: the dashed chord between the interface nodes, and a
+    // marker at each
+    let p =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/fuzz/superelement_chain.ron");
+    let scene = Scene::load(&p).unwrap();
+    let se = Arc::new(scene.build(p.parent()).unwrap());
+    let at = Configuration::static_equilibrium(&se).unwrap();
+    let g = geometry(&se, &at.x, View::Iso);
+    for (id, a, b) in [("se1", "P", "M"), ("se2", "M", "Q")] {
+        let chord = items_of(&g, ItemKind::SuperelementChord, id);
+        assert_eq!(chord.len(), 1, "{id}");
+        let (pa, pb) = (node_at(&se, &at.x, a), node_at(&se, &at.x, b));
+        assert_eq!(chord[0].model, vec![pa, pb], "{id}");
+        let ends: Vec<[f64; 3]> = items_of(&g, ItemKind::InterfaceNode, id)
+            .iter()
+            .map(|i| i.model[0])
+            .collect();
+        assert_eq!(ends, vec![pa, pb], "{id}");
+    }
+    // the tip load and gravity moved Q off the reference
+    let q = node_at(&se, &at.x, "Q");
+    assert!(q[1] > 1e-9 && q[2] < -1e-9, "Q at {q:?}");
+    assert_eq!(items_of(&g, ItemKind::PointMass, "tip")[0].model, vec![q]);
+}
