@@ -486,6 +486,14 @@ fn write(
         out,
         "speed_vs_error_guidance",
     )?;
+    let mode_freqs = crate::pictures::guidance(
+        &mut figs,
+        out,
+        &g.mech,
+        (T_LOAD, g.lambda_max),
+        "The planar guidance at its maximal deflection (grey: reference)",
+        3,
+    )?;
     // report
     let mut s = String::new();
     let _ = writeln!(
@@ -547,9 +555,18 @@ fn write(
     let _ = writeln!(s, "### Manipulator\n\n{}", speed_vs_error_table(&man_rows));
     let _ = writeln!(
         s,
+        "{}",
+        crate::pictures::section(&figs, g.lambda_max, &mode_freqs)
+    );
+    let _ = writeln!(
+        s,
         "## Figures\n\nEach figure is written as SVG and PNG side by side.\n"
     );
-    let _ = writeln!(s, "{}", figs.markdown(|f| !f.starts_with("speed_vs_error")));
+    let _ = writeln!(
+        s,
+        "{}",
+        figs.markdown(|f| !f.starts_with("speed_vs_error") && !f.starts_with("mech_"))
+    );
     std::fs::write(out.join("report.md"), s)?;
     Ok(rows_out)
 }

@@ -11,6 +11,7 @@ pub mod ch6;
 pub mod curves;
 pub mod fuzz;
 pub mod models;
+pub mod pictures;
 pub mod progress;
 pub mod regress;
 pub mod report;

@@ -375,6 +375,14 @@ fn write_outputs(
         out,
         "speed_vs_error",
     )?;
+    let mode_freqs = crate::pictures::guidance(
+        &mut figs,
+        out,
+        &setup.def,
+        (ch6::T_LOAD, setup.lambda_max),
+        "Fig. 6.5: the guidance at its maximal deflection (grey: reference)",
+        4,
+    )?;
     // report
     let mut s = String::new();
     let _ = writeln!(
@@ -462,8 +470,17 @@ fn write_outputs(
     let _ = writeln!(s, "Errors with respect to the unreduced model integrated with Adams: eigenfrequency errors are the largest relative deviation over the stroke of each retained eigenfrequency (ω1–ω2 or ω1–ω4, compared at equal x-displacement); time-response errors are the RMS and maximum deviation of the x- and z-displacement of S over all outputs, relative to max |x| ({:.4} m) and to the peak-to-peak z ({:.3e} m) of the unreduced response. Wall time is the integration only (one core; the machine ran two jobs at once). \n", x_scale, z_scale);
     let _ = writeln!(s, "{}", speed_vs_error_table(&rows_out));
     let _ = writeln!(s, "{}", figs.markdown(|f| f == "speed_vs_error"));
+    let _ = writeln!(
+        s,
+        "{}",
+        crate::pictures::section(&figs, setup.lambda_max, &mode_freqs)
+    );
     let _ = writeln!(s, "## Figures\n");
-    let _ = writeln!(s, "{}", figs.markdown(|f| f != "speed_vs_error"));
+    let _ = writeln!(
+        s,
+        "{}",
+        figs.markdown(|f| f != "speed_vs_error" && !f.starts_with("mech_"))
+    );
     std::fs::write(out.join("report.md"), s)?;
     Ok(rows_out)
 }

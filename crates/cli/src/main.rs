@@ -11,6 +11,7 @@
 #![deny(clippy::print_stdout, clippy::print_stderr)]
 
 mod coords;
+mod draw;
 mod finite;
 mod interrupt;
 mod options;
@@ -99,6 +100,9 @@ enum Command {
     /// Build a reduced model (fixed or interpolated basis) of a scene and save
     /// it for `simulate --reduced` and `sweep --reduced` (see docs/cli.md).
     Reduce(reduce::ReduceArgs),
+    /// Draw the mechanism (reference, static equilibrium or a state) and its
+    /// mode shapes as SVG or PNG (see docs/cli.md).
+    Draw(draw::DrawArgs),
     /// Build a linear superelement from FE matrices (see crates/superelement/README.md).
     BuildSuperelement {
         /// Specification file (RON).
@@ -269,6 +273,7 @@ fn run(command: Command) -> Result<(), Failure> {
         } => eig(&scene, modes, static_first, buckling),
         Command::Sweep(a) => sweep(&a),
         Command::Reduce(a) => reduce::reduce(&a),
+        Command::Draw(a) => draw::draw(&a),
         Command::BuildSuperelement { spec } => build_superelement(&spec),
     }
 }

@@ -584,6 +584,90 @@ fn option_rows(k: &mut Catalogue) {
     }
 }
 
+/// The rows of `flexmb draw`: modes, views, amplitudes, phases, state
+/// files and figure names.
+fn draw_rows(k: &mut Catalogue) {
+    let g = k.good();
+    let fig = k.path("fig.svg");
+    let unknown_column = k.file("state_bad.csv", "t,S.q\n0,1\n");
+    let not_a_dof = k.file("state_not_dof.csv", "S.x\n0.1\n");
+    let no_rows = k.file("state_empty.csv", "flexure1.1.bending_p\n");
+    let dev_null = "/dev/null/fig.png".to_string();
+    let rows: [(&'static str, &[&str], &[&str]); 11] = [
+        (
+            "draw --mode beyond the modes",
+            &["--mode 18", "17 modes", "numbered 1 to 17"],
+            &["draw", &g, "--mode", "18", "--out", &fig],
+        ),
+        (
+            "draw --mode 0",
+            &["--mode must be at least 1"],
+            &["draw", &g, "--mode", "0", "--out", &fig],
+        ),
+        (
+            "draw unknown --view",
+            &["--view", "'top'", "iso, xy, xz or yz"],
+            &["draw", &g, "--view", "top", "--out", &fig],
+        ),
+        (
+            "draw --out with another extension",
+            &["fig.pdf", ".svg or .png"],
+            &["draw", &g, "--out", "fig.pdf"],
+        ),
+        (
+            "draw --out without an extension",
+            &["--out", "fig", ".svg or .png"],
+            &["draw", &g, "--out", "fig"],
+        ),
+        (
+            "draw --out in an unwritable place",
+            &["--out", "/dev/null/fig.png", "cannot write there"],
+            &["draw", &g, "--out", &dev_null],
+        ),
+        (
+            "draw --amplitude negative",
+            &["--amplitude", "positive", "-0.01"],
+            &[
+                "draw",
+                &g,
+                "--mode",
+                "1",
+                "--amplitude",
+                "-0.01",
+                "--out",
+                &fig,
+            ],
+        ),
+        (
+            "draw --phases 0",
+            &["--phases must be at least 1"],
+            &["draw", &g, "--mode", "1", "--phases", "0", "--out", &fig],
+        ),
+        (
+            "draw --state with an unknown column",
+            &["state_bad.csv", "'S.q'", "flexmb info"],
+            &["draw", &g, "--state", &unknown_column, "--out", &fig],
+        ),
+        (
+            "draw --state with a coordinate that is no DOF",
+            &[
+                "state_not_dof.csv",
+                "'S.x'",
+                "not one of its degrees of freedom",
+            ],
+            &["draw", &g, "--state", &not_a_dof, "--out", &fig],
+        ),
+        (
+            "draw --state without values",
+            &["state_empty.csv", "no row of values"],
+            &["draw", &g, "--state", &no_rows, "--out", &fig],
+        ),
+    ];
+    for (what, culprit, args) in rows {
+        k.case(what, 2, culprit, args);
+    }
+}
+
 /// The rows of `flexmb reduce` options.
 fn reduce_rows(k: &mut Catalogue) {
     let g = k.good();
@@ -959,6 +1043,7 @@ fn every_bad_input_gives_its_exit_code_and_names_the_culprit() {
     scene_rows(&mut k);
     option_rows(&mut k);
     reduce_rows(&mut k);
+    draw_rows(&mut k);
     file_rows(&mut k);
     let n = k.cases.len();
     assert!(n >= 40, "{n} rows");

@@ -89,6 +89,7 @@
 /// The dense and sparse matrices of the system level (faer), as in
 /// [`Basis`](reduction::Basis) and the linearizations.
 pub use faer;
+pub use flexmb_draw as draw;
 pub use flexmb_dual as dual;
 pub use flexmb_dynamics as dynamics;
 pub use flexmb_element as element;

@@ -265,7 +265,7 @@ struct Extra {
 /// Computes the layout of `plot` at `scale` (1: the nominal size in pixels).
 pub fn layout(plot: &Plot, scale: f64) -> io::Result<Layout> {
     let mut extra = Extra::default();
-    let mut lay = layout_once(plot, scale, extra)?;
+    let mut lay = layout_once(plot, scale, extra, None)?;
     for _ in 0..6 {
         let (ok, need) = place_point_labels(plot, &mut lay)?;
         if ok {
@@ -275,12 +275,52 @@ pub fn layout(plot: &Plot, scale: f64) -> io::Result<Layout> {
         extra.r += need.r;
         extra.b += need.b;
         extra.t += need.t;
-        lay = layout_once(plot, scale, extra)?;
+        lay = layout_once(plot, scale, extra, None)?;
+    }
+    if plot.equal_aspect {
+        // the ranges grow (never shrink) until a data unit is as many pixels
+        // on both axes; the plot area moves with the tick labels, so again
+        for _ in 0..4 {
+            let ranges = equal_aspect_ranges(&lay);
+            let area = lay.area;
+            lay = layout_once(plot, scale, extra, Some(ranges))?;
+            place_point_labels(plot, &mut lay)?;
+            if lay.area == area {
+                break;
+            }
+        }
     }
     Ok(lay)
 }
 
-fn layout_once(plot: &Plot, s: f64, extra: Extra) -> io::Result<Layout> {
+/// The x and y ranges of `lay`, the one with fewer data units per pixel
+/// widened about its centre to the other's (linear axes; a log axis is
+/// kept).
+fn equal_aspect_ranges(lay: &Layout) -> (Range, Range) {
+    let (pw, ph) = (lay.area.x1 - lay.area.x0, lay.area.y1 - lay.area.y0);
+    if lay.x.scale != Scale::Linear || lay.y.scale != Scale::Linear || pw <= 0.0 || ph <= 0.0 {
+        return (lay.x, lay.y);
+    }
+    let u = ((lay.x.hi - lay.x.lo) / pw).max((lay.y.hi - lay.y.lo) / ph);
+    let widen = |r: Range, len: f64| {
+        let c = 0.5 * (r.lo + r.hi);
+        Range {
+            lo: c - 0.5 * u * len,
+            hi: c + 0.5 * u * len,
+            scale: r.scale,
+        }
+    };
+    (widen(lay.x, pw), widen(lay.y, ph))
+}
+
+/// The layout with `extra` pixels kept free beside the data, and the axis
+/// ranges `forced` (x, y) instead of those padded around the data.
+fn layout_once(
+    plot: &Plot,
+    s: f64,
+    extra: Extra,
+    forced: Option<(Range, Range)>,
+) -> io::Result<Layout> {
     let marker_r = MARKER_R * s;
     let margin = MARKER_EXTENT * marker_r + 5.0 * s;
     let title_probe = Text::new(
@@ -341,13 +381,18 @@ fn layout_once(plot: &Plot, s: f64, extra: Extra) -> io::Result<Layout> {
     let ph = height - top - bottom;
     // y axis
     let (ylo, yhi) = extent(plot, plot.y_scale, |_, y| y);
-    let y = Range::padded(
-        plot.y_scale,
-        ylo,
-        yhi,
-        ph,
-        margin + extra.b,
-        margin + extra.t,
+    let y = forced.map_or_else(
+        || {
+            Range::padded(
+                plot.y_scale,
+                ylo,
+                yhi,
+                ph,
+                margin + extra.b,
+                margin + extra.t,
+            )
+        },
+        |f| f.1,
     );
     let y_at = |v: f64| top + ph - y.fraction(v).unwrap_or(0.0) * ph;
     // y tick labels are placed at x = 0 for now and shifted once `left` is known
@@ -391,13 +436,18 @@ fn layout_once(plot: &Plot, s: f64, extra: Extra) -> io::Result<Layout> {
         .collect();
     // x axis
     let (xlo, xhi) = extent(plot, plot.x_scale, |x, _| x);
-    let x = Range::padded(
-        plot.x_scale,
-        xlo,
-        xhi,
-        pw,
-        margin + extra.l,
-        margin + extra.r,
+    let x = forced.map_or_else(
+        || {
+            Range::padded(
+                plot.x_scale,
+                xlo,
+                xhi,
+                pw,
+                margin + extra.l,
+                margin + extra.r,
+            )
+        },
+        |f| f.0,
     );
     let x_at = |v: f64| left + x.fraction(v).unwrap_or(0.0) * pw;
     let ty = top + ph + 8.0 * s + tick_h / 2.0;

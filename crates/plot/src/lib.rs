@@ -56,6 +56,10 @@ pub struct Series {
     pub style: Style,
     /// Labels written next to the points (empty: none), one per point.
     pub point_labels: Vec<String>,
+    /// Its colour (RGB) instead of the next one of the palette.
+    pub color: Option<(u8, u8, u8)>,
+    /// Its marker shape instead of the next one of the sequence.
+    pub marker: Option<Marker>,
 }
 
 impl Series {
@@ -67,6 +71,8 @@ impl Series {
             y: y.to_vec(),
             style: Style::Line,
             point_labels: vec![],
+            color: None,
+            marker: None,
         }
     }
     /// A dashed line series.
@@ -95,6 +101,16 @@ impl Series {
         self.point_labels = labels.into_iter().map(Into::into).collect();
         self
     }
+    /// Drawn in this colour (RGB) instead of the palette's.
+    pub fn with_color(mut self, rgb: (u8, u8, u8)) -> Self {
+        self.color = Some(rgb);
+        self
+    }
+    /// Drawn with this marker shape instead of the sequence's.
+    pub fn with_marker(mut self, m: Marker) -> Self {
+        self.marker = Some(m);
+        self
+    }
 }
 
 /// A 2-D plot: lines, dashed lines and markers on linear or log axes.
@@ -109,6 +125,7 @@ pub struct Plot {
     x_unit: String,
     y_unit: String,
     legend: bool,
+    equal_aspect: bool,
     width: f64,
     height: f64,
 }
@@ -126,6 +143,7 @@ impl Plot {
             x_unit: String::new(),
             y_unit: String::new(),
             legend: true,
+            equal_aspect: false,
             width: 800.0,
             height: 500.0,
         }
@@ -170,6 +188,13 @@ impl Plot {
     /// No legend (for plots whose points carry their own labels).
     pub fn without_legend(mut self) -> Self {
         self.legend = false;
+        self
+    }
+    /// One data unit is as long on the x axis as on the y axis (linear
+    /// axes; for drawings of mechanisms): the axis whose data would be
+    /// drawn larger gets a wider range, centred on the data.
+    pub fn equal_aspect(mut self) -> Self {
+        self.equal_aspect = true;
         self
     }
     /// The nominal size in pixels (the figure grows where its labels need it).

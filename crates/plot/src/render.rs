@@ -22,13 +22,15 @@ fn px(p: (f64, f64)) -> (i32, i32) {
     (p.0.round() as i32, p.1.round() as i32)
 }
 
-fn series_color(k: usize) -> RGBColor {
-    let (r, g, b) = COLORS[k % COLORS.len()];
+/// The colour of series `k`: its own, or the palette's k-th.
+fn series_color(plot: &Plot, k: usize) -> RGBColor {
+    let (r, g, b) = plot.series[k].color.unwrap_or(COLORS[k % COLORS.len()]);
     RGBColor(r, g, b)
 }
 
-fn series_marker(k: usize) -> Marker {
-    MARKERS[k % MARKERS.len()]
+/// The marker of series `k`: its own, or the sequence's k-th.
+fn series_marker(plot: &Plot, k: usize) -> Marker {
+    plot.series[k].marker.unwrap_or(MARKERS[k % MARKERS.len()])
 }
 
 fn text<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, t: &Text, color: &RGBColor) -> Res<DB> {
@@ -160,7 +162,7 @@ pub(crate) fn draw<DB: DrawingBackend>(
     // series: lines first, markers over them
     let lw = (style::LINE_W * s).round().max(1.0) as u32;
     for (k, se) in plot.series.iter().enumerate() {
-        let c = series_color(k);
+        let c = series_color(plot, k);
         if se.style == Style::Points {
             continue;
         }
@@ -183,10 +185,10 @@ pub(crate) fn draw<DB: DrawingBackend>(
         if se.style != Style::Points {
             continue;
         }
-        let c = series_color(k);
+        let c = series_color(plot, k);
         for (x, y) in se.x.iter().zip(&se.y) {
             if let Some(p) = lay.px(*x, *y) {
-                marker(root, series_marker(k), p, lay.marker_r, &c)?;
+                marker(root, series_marker(plot, k), p, lay.marker_r, &c)?;
             }
         }
     }
@@ -206,12 +208,12 @@ pub(crate) fn draw<DB: DrawingBackend>(
         ))?;
         for e in &l.entries {
             let se = &plot.series[e.series];
-            let c = series_color(e.series);
+            let c = series_color(plot, e.series);
             let (x0, cy) = e.sample;
             match se.style {
                 Style::Points => marker(
                     root,
-                    series_marker(e.series),
+                    series_marker(plot, e.series),
                     (x0 + e.sample_len / 2.0, cy),
                     lay.marker_r,
                     &c,

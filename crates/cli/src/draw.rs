@@ -1,0 +1,132 @@
+//! `flexmb draw`: a picture of the mechanism (reference, static equilibrium
+//! or a given state) and its mode shapes, by the library crate
+//! `flexmb-draw`.
+
+use crate::{coords, load, options, Failure};
+use clap::Args;
+use flexmb_draw::{Configuration, DrawError, DrawOptions, View};
+use flexmb_model::Mechanism;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Options of `flexmb draw`.
+#[derive(Args)]
+pub(crate) struct DrawArgs {
+    /// Scene file (RON).
+    scene: PathBuf,
+    /// Draw this state: a CSV file whose columns are degrees of freedom
+    /// (named as `flexmb info` prints them, or `q:NAME` as `simulate`
+    /// writes them) and optionally `t`; its last row is drawn, degrees of
+    /// freedom it does not list keep their reference values.
+    #[arg(long, value_name = "FILE.csv", conflicts_with = "static_first")]
+    state: Option<PathBuf>,
+    /// Draw the static equilibrium under the scene's loads and gravity at t = 0.
+    #[arg(long)]
+    static_first: bool,
+    /// Draw mode shape K (from 1, lowest frequency) of the linearization at
+    /// the drawn configuration.
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
+    mode: Option<usize>,
+    /// The mode's largest nodal displacement (m) [default: 10 % of the
+    /// mechanism's size].
+    #[arg(long, value_name = "A", allow_hyphen_values = true)]
+    amplitude: Option<f64>,
+    /// Phases of the mode drawn, from +A to −A in equal steps, fading [default: 1].
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    phases: Option<usize>,
+    /// Overlay the reference configuration in light grey.
+    #[arg(long)]
+    reference: bool,
+    /// iso, xy, xz or yz [default: xy for planar scenes, iso for spatial].
+    #[arg(long)]
+    view: Option<String>,
+    /// The figure: FIG.svg or FIG.png.
+    #[arg(long, value_name = "FIG.svg|FIG.png")]
+    out: PathBuf,
+}
+
+fn failure(e: DrawError) -> Failure {
+    match e {
+        DrawError::Input(m) => Failure::Input(m),
+        DrawError::Compute(m) | DrawError::Write(m) => Failure::Compute(m),
+    }
+}
+
+/// `flexmb draw`.
+pub(crate) fn draw(a: &DrawArgs) -> Result<(), Failure> {
+    let view = a
+        .view
+        .as_deref()
+        .map(|v| {
+            v.parse::<View>()
+                .map_err(|e| Failure::Input(format!("--view: {e}")))
+        })
+        .transpose()?;
+    if let Some(k) = a.mode {
+        options::at_least("--mode", k, 1, "modes are numbered from 1")?;
+    }
+    if let Some(amp) = a.amplitude {
+        options::positive("--amplitude", amp)?;
+    }
+    if let Some(n) = a.phases {
+        options::at_least("--phases", n, 1, "the phases of the mode drawn")?;
+    }
+    flexmb_draw::figure_format(&a.out).map_err(|e| Failure::Input(format!("--out {e}")))?;
+    options::writable_file("--out", &a.out)?;
+    let (_, mech) = load(&a.scene)?;
+    if let Some(k) = a.mode {
+        flexmb_draw::check_mode(&mech, k).map_err(|e| Failure::Input(format!("--mode {e}")))?;
+    }
+    let at = if a.static_first {
+        Configuration::static_equilibrium(&mech)
+    } else if let Some(file) = &a.state {
+        Configuration::at(&mech, &read_state(&mech, file)?)
+    } else {
+        Configuration::reference(&mech)
+    }
+    .map_err(failure)?;
+    let opts = DrawOptions {
+        view,
+        reference: a.reference,
+        mode: a.mode,
+        amplitude: a.amplitude,
+        phases: a.phases,
+        title: None,
+    };
+    let pic = flexmb_draw::picture(&at, &opts).map_err(failure)?;
+    pic.save(&a.out).map_err(failure)?;
+    if let Some((m, _)) = &pic.mode {
+        crate::say!("mode {}: {:.6} Hz", m.number, m.frequency_hz);
+    }
+    crate::say!("wrote {}", a.out.display());
+    Ok(())
+}
+
+/// The degrees of freedom of the state file `file` (see [`DrawArgs`]).
+fn read_state(mech: &Arc<Mechanism>, file: &Path) -> Result<Vec<f64>, Failure> {
+    let bad = |m: String| Failure::Input(format!("--state {}: {m}", file.display()));
+    let (header, rows) = flexmb_plot::read_csv(file).map_err(|e| bad(e.to_string()))?;
+    let last = rows
+        .last()
+        .ok_or_else(|| bad("no row of values after the header".into()))?;
+    if last.len() != header.len() {
+        return Err(bad(format!(
+            "the last row has {} values for the {} columns {header:?}",
+            last.len(),
+            header.len()
+        )));
+    }
+    let mut q = mech.q0();
+    for (name, v) in header.iter().zip(last) {
+        if name == "t" {
+            continue;
+        }
+        if !v.is_finite() {
+            return Err(bad(format!("{name} is {v}")));
+        }
+        let dof = name.strip_prefix("q:").unwrap_or(name);
+        let k = coords::dof_index(mech, dof, &format!("--state {}:", file.display()))?;
+        q[k] = *v;
+    }
+    Ok(q)
+}
