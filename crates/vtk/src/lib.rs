@@ -13,10 +13,16 @@
 //!   superelement, 5 point mass, 6 rigid body, 0 other: [`KINDS`]) and `axial_stiffness`, the first diagonal entry of
 //!   the element's stiffness times its reference length (EA of a beam or
 //!   truss, zero for kinds without an elongation).
+//! * Field data (values of the whole data set, e.g. a mode's frequency):
+//!   [`configuration_with_fields`].
+//! * A mode shape is an animated series over one period ([`mode_frames`],
+//!   point data `mode_shape`); [`node_vectors`] gives the node vectors of
+//!   any vector on the nodal coordinates, to write modes as point data.
 //! * A series is written as `NAME_0000.vtu`, … and `NAME.pvd`.
 //!
 //! Not yet: superelements drawn as their FE mesh with the displacement field
-//! recovered from their modes, and beams extruded to their section.
+//! recovered from their modes (the `.se.ron` file holds no FE mesh and no
+//! recovery matrix), and beams extruded to their section.
 
 use flexmb_model::Mechanism;
 use std::fmt::Write as _;
