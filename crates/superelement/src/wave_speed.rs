@@ -110,8 +110,10 @@ pub const PLAUSIBLE_WAVE_SPEED: [f64; 2] = [1000.0, 13000.0];
 
 impl InferredMaterial {
     /// What to set in a spec when the wave speed is outside
-    /// [`PLAUSIBLE_WAVE_SPEED`]: the unit systems whose length unit brings
-    /// it in (coordinates and matrices in mm), else the power-of-ten
+    /// [`PLAUSIBLE_WAVE_SPEED`]: the unit systems whose velocity unit
+    /// (length/time = √(length · force / mass)) brings it in (files in
+    /// mm–t–s or mm–kg–s read as SI give a speed 1000 × too large; mm–kg–ms
+    /// has the velocity unit m/s and is not told by it), else the power-of-ten
     /// `stiffness_scale` that brings it nearest to a metal's 5000 m/s;
     /// `None` when it is plausible.
     pub fn advice(&self) -> Option<String> {
@@ -122,7 +124,10 @@ impl InferredMaterial {
         }
         let systems: Vec<&str> = crate::units::UNIT_SYSTEMS
             .iter()
-            .filter(|u| u.name != "SI" && (lo..=hi).contains(&(c * u.length)))
+            .filter(|u| {
+                let velocity = (u.length * u.force / u.mass).sqrt();
+                u.name != "SI" && (lo..=hi).contains(&(c * velocity))
+            })
             .map(|u| u.name)
             .collect();
         let scale = 10f64.powi((2.0 * (5000.0 / c).log10()).round() as i32);
@@ -133,7 +138,7 @@ impl InferredMaterial {
         );
         if !systems.is_empty() {
             s += &format!(
-                "; if the coordinates and matrices are in mm, set `units: Some(\"{}\")`",
+                "; if the files are in those units, set `units: Some(\"{}\")`",
                 systems.join("\" or \"")
             );
         }
@@ -143,5 +148,37 @@ impl InferredMaterial {
             c * scale.sqrt()
         );
         Some(s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::InferredMaterial;
+
+    fn with_speed(c: f64) -> InferredMaterial {
+        InferredMaterial {
+            constrained_times_volume: 1.0,
+            shear_times_volume: 1.0,
+            anisotropy: 0.0,
+            mass: 1.0,
+            young_times_volume: c * c,
+            poisson: 0.3,
+            wave_speed: c,
+        }
+    }
+
+    #[test]
+    fn the_advice_names_the_unit_systems_with_a_millimetre_per_second_speed() {
+        assert_eq!(with_speed(5172.0).advice(), None);
+        // steel in mm–t–s read as SI: 5.172e6 mm/s
+        let a = with_speed(5.172e6).advice().unwrap();
+        assert!(a.contains("units: Some(\"mm-t-s\" or \"mm-kg-s\")"), "{a}");
+        assert!(!a.contains("mm-kg-ms"), "{a}");
+        assert!(a.contains("stiffness_scale: Some(1e-6)"), "{a}");
+        let a = with_speed(517.2).advice().unwrap();
+        assert!(
+            !a.contains("units:") && a.contains("stiffness_scale: Some(1e2)"),
+            "{a}"
+        );
     }
 }
