@@ -113,8 +113,9 @@ impl InferredMaterial {
     /// [`PLAUSIBLE_WAVE_SPEED`]: the unit systems whose velocity unit
     /// (length/time = √(length · force / mass)) brings it in (files in
     /// mm–t–s or mm–kg–s read as SI give a speed 1000 × too large; mm–kg–ms
-    /// has the velocity unit m/s and is not told by it), else the power-of-ten
-    /// `stiffness_scale` that brings it nearest to a metal's 5000 m/s;
+    /// has the velocity unit m/s and is not told by it), and the power-of-ten
+    /// factor on the stiffness (as built, so on top of a spec's
+    /// `stiffness_scale`) that brings it nearest to a metal's 5000 m/s;
     /// `None` when it is plausible.
     pub fn advice(&self) -> Option<String> {
         let [lo, hi] = PLAUSIBLE_WAVE_SPEED;
@@ -143,8 +144,9 @@ impl InferredMaterial {
             );
         }
         s += &format!(
-            "; if the stiffness came from a model with another Young's modulus, \
-             `stiffness_scale: Some({scale:e})` gives {:.4e} m/s",
+            "; if the stiffness came from a model with another Young's modulus, the stiffness \
+             × {scale:e} (`stiffness_scale: Some({scale:e})` where none is set, else the spec's \
+             scale × {scale:e}) gives {:.4e} m/s",
             c * scale.sqrt()
         );
         Some(s)
