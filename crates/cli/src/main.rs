@@ -93,6 +93,11 @@ enum Command {
         /// Also report buckling load factors of the current loads.
         #[arg(long)]
         buckling: bool,
+        /// Also write the configuration (eig.pvd, modes as point data
+        /// mode_1, …) and each mode as an animated series over one period
+        /// (mode_K.pvd) as VTK to this directory.
+        #[arg(long, value_name = "DIR")]
+        vtk: Option<PathBuf>,
     },
     /// Eigenfrequencies along the range of motion: over a load scale or a
     /// held coordinate, n equilibria, eigen analyses in parallel.
@@ -189,6 +194,11 @@ struct SweepArgs {
     /// Output directory.
     #[arg(long, default_value = "results/sweep")]
     out: PathBuf,
+    /// Also write the equilibrium at every sweep point as VTK (sweep.pvd,
+    /// the sweep parameter as time, the modes as point data mode_1, …) to
+    /// this directory.
+    #[arg(long, value_name = "DIR")]
+    vtk: Option<PathBuf>,
 }
 
 /// Why a command failed, which decides the exit code.
@@ -270,7 +280,8 @@ fn run(command: Command) -> Result<(), Failure> {
             modes,
             static_first,
             buckling,
-        } => eig(&scene, modes, static_first, buckling),
+            vtk,
+        } => eig(&scene, modes, static_first, buckling, vtk.as_deref()),
         Command::Sweep(a) => sweep(&a),
         Command::Reduce(a) => reduce::reduce(&a),
         Command::Draw(a) => draw::draw(&a),
@@ -566,11 +577,15 @@ fn eig(
     modes: Option<usize>,
     static_first: bool,
     buckling: bool,
+    vtk: Option<&Path>,
 ) -> Result<(), Failure> {
     if let Some(k) = modes {
         options::at_least("--modes", k, 1, "the number of modes")?;
     }
     let (_, mech) = load(path)?;
+    if let Some(d) = vtk {
+        options::writable_dir("--vtk", d)?;
+    }
     let k = options::modes_or_default(modes, 10, &mech)?;
     let mut dy = Dynamics::new(mech.clone());
     let mut q = mech.q0();
@@ -631,6 +646,10 @@ fn eig(
             }
             Err(e) => say!("buckling: {e}"),
         }
+    }
+    if let Some(d) = vtk {
+        let (x, shapes) = vtk_out::nodal_modes(&mut dy, 0.0, &q, &modes.vectors)?;
+        vtk_out::write_eig(d, &mech, 0.0, &x, &shapes, &frequencies)?;
     }
     Ok(())
 }
@@ -693,6 +712,9 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
     };
     let k = options::modes_or_default(a.modes, 6, &mech)?;
     options::writable_dir("--out", &a.out)?;
+    if let Some(d) = &a.vtk {
+        options::writable_dir("--vtk", d)?;
+    }
     say!("{}", mech.summary());
     let pb = count_bar(2 * n as u64, "equilibria, then eigen analyses");
     let start = std::time::Instant::now();
@@ -700,7 +722,7 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         values,
         modes: k,
         t: a.t_load,
-        keep_vectors: false,
+        keep_vectors: a.vtk.is_some(),
     };
     let phase = interrupt::stoppable();
     let outcome = flexmb_linearize::sweep_until(
@@ -745,6 +767,9 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         comments.push(format!("interrupted: {done} of {n} configurations"));
     }
     write_frequency_sweep(&sw, &comments, &a.out)?;
+    if let Some(d) = &a.vtk {
+        vtk_out::write_sweep_points(d, &mech, a.t_load, &pts)?;
+    }
     if outcome.stopped {
         return Err(Failure::Interrupted(format!(
             "partial results written: {done} of {n} configurations"

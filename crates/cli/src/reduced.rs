@@ -63,6 +63,9 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
     let (_, mech) = crate::load(&a.scene)?;
     let (_, mut red) = load_model(&mech, model)?;
     crate::options::writable_dir("--out", &a.out)?;
+    if let Some(d) = &a.vtk {
+        crate::options::writable_dir("--vtk", d)?;
+    }
     let n = values.len();
     let asked = a.modes.unwrap_or(6);
     let k = asked.min(red.n_z());
@@ -91,7 +94,7 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
     drop(phase);
     pb.finish_and_clear();
     let points = sweep.map_err(|e| Failure::Compute(format!("reduced sweep: {e}")))?;
-    let freqs: Vec<Vec<f64>> = points.into_iter().map(|p| p.frequencies).collect();
+    let freqs: Vec<Vec<f64>> = points.iter().map(|p| p.frequencies.clone()).collect();
     let done = freqs.len();
     if done == 0 {
         return Err(Failure::Interrupted(
@@ -118,6 +121,9 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
         comments.push(format!("interrupted: {done} of {n} configurations"));
     }
     write_frequency_sweep(&sw, &comments, &a.out)?;
+    if let Some(d) = &a.vtk {
+        crate::vtk_out::write_reduced_sweep(d, &mut red, a.t_load, k, &points)?;
+    }
     if done < n {
         return Err(Failure::Interrupted(format!(
             "partial results written: {done} of {n} configurations"

@@ -246,10 +246,12 @@ fn a_second_signal_exits_at_once() {
 
 /// A long held-coordinate sweep (3000 equilibria of the spatial guidance):
 /// SIGINT stops it before the next configuration or Newton iteration, with
-/// exit code 130, saying what was written.
+/// exit code 130, saying what was written; with `--vtk`, the VTK series
+/// has the configurations of the CSV.
 #[test]
 fn an_interrupted_sweep_stops_at_once_and_says_what_was_written() {
     let out = temp_dir("sweep");
+    let vtk = temp_dir("sweep-vtk");
     let scene = fixture("straight_guidance_spatial.ron");
     let args = [
         "sweep",
@@ -264,6 +266,8 @@ fn an_interrupted_sweep_stops_at_once_and_says_what_was_written() {
         "3000",
         "--modes",
         "2",
+        "--vtk",
+        vtk.to_str().unwrap(),
     ];
     let mut child = start(&args, &out);
     let _stdout = wait_until_computing(&mut child, Duration::from_millis(300));
@@ -276,9 +280,13 @@ fn an_interrupted_sweep_stops_at_once_and_says_what_was_written() {
         assert!(!csv.exists());
     } else {
         assert!(err.contains("partial results written"), "{err}");
-        assert!((1..3000).contains(&rows(&csv).len()));
+        let done = rows(&csv).len();
+        assert!((1..3000).contains(&done));
+        let pvd = std::fs::read_to_string(vtk.join("sweep.pvd")).unwrap();
+        assert_eq!(pvd.matches("<DataSet").count(), done, "{pvd}");
     }
     let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&vtk);
 }
 
 /// `flexmb reduce` has nothing partial to write (a model from part of its

@@ -68,6 +68,7 @@ pub mod solid;
 pub mod spec;
 mod symmetric;
 pub mod units;
+pub mod wave_speed;
 
 pub use builder::{
     build, compatible_interface_pattern, fixed_interface_eigenvalues_dense,

@@ -422,3 +422,60 @@ fn a_model_in_mm_t_s_read_as_si_is_refused_with_the_units_to_set() {
         .fold(0.0f64, f64::max);
     assert!(d < 1e-12, "{d:e}");
 }
+
+/// The material inferred from K and M by linear fields
+/// ([`flexmb_superelement::wave_speed`]) against the decks' materials:
+/// the Abaqus rotor (steel, E = 2.1e11, ρ = 7850, ν = 0.3), the ANSYS rotor
+/// (E = 2.1e9, its README), the C3D10 block (E = 2e11, ρ = 2900, ν = 0.3).
+/// The ANSYS rotor's wave speed (517 m/s) is implausible and the advice
+/// names the stiffness scale of 100 that makes it steel; the others pass.
+#[test]
+fn the_linear_field_energies_give_the_decks_material_and_tell_the_stiffness_scale() {
+    use flexmb_superelement::wave_speed::infer_material;
+    let a = dir().join("abaqus");
+    let block = read_abaqus(
+        &a.join("blockC3D10.inp"),
+        &a.join("blockC3D10_STIF1.mtx"),
+        &a.join("blockC3D10_MASS1.mtx"),
+    )
+    .unwrap()
+    .0;
+    for (name, model, e, rho) in [
+        ("Abaqus rotor", abaqus_rotor(), 2.1e11, 7850.0_f64),
+        ("ANSYS rotor", ansys_rotor(), 2.1e9, 7850.0),
+        ("C3D10 block", block, 2e11, 2900.0),
+    ] {
+        let m = infer_material(&model).unwrap_or_else(|| panic!("{name}: no material"));
+        let c = (e / rho).sqrt();
+        assert!(
+            (m.wave_speed / c - 1.0).abs() < 1e-6,
+            "{name}: {m:?}, want c = {c}"
+        );
+        assert!((m.poisson - 0.3).abs() < 1e-6, "{name}: {m:?}");
+        assert!(m.anisotropy < 1e-6, "{name}: {m:?}");
+        // the mass over the density is the volume
+        let young = m.young(m.mass / rho);
+        assert!((young / e - 1.0).abs() < 1e-6, "{name}: E = {young}");
+        match m.advice() {
+            None => assert!(e > 1e10, "{name}: no advice for {m:?}"),
+            Some(s) => {
+                assert_eq!(name, "ANSYS rotor", "{s}");
+                assert!(s.contains("stiffness_scale: Some(1e2)"), "{s}");
+            }
+        }
+    }
+    // the build report says it, and warns for the ANSYS rotor only
+    let s = rotor_settings();
+    let steel = build(&abaqus_rotor(), &s).unwrap().summary("steel");
+    assert!(
+        steel.contains("wave speed √(E/ρ) = 5.1722e3 m/s"),
+        "{steel}"
+    );
+    assert!(!steel.contains("warning"), "{steel}");
+    let soft = build(&ansys_rotor(), &s).unwrap().summary("soft");
+    assert!(soft.contains("wave speed √(E/ρ) = 5.1722e2 m/s"), "{soft}");
+    assert!(
+        soft.contains("warning: ") && soft.contains("Some(1e2)"),
+        "{soft}"
+    );
+}

@@ -13,10 +13,16 @@
 //!   superelement, 5 point mass, 6 rigid body, 0 other: [`KINDS`]) and `axial_stiffness`, the first diagonal entry of
 //!   the element's stiffness times its reference length (EA of a beam or
 //!   truss, zero for kinds without an elongation).
+//! * Field data (values of the whole data set, e.g. a mode's frequency):
+//!   [`configuration_with_fields`].
+//! * A mode shape is an animated series over one period ([`mode_frames`],
+//!   point data `mode_shape`); [`node_vectors`] gives the node vectors of
+//!   any vector on the nodal coordinates, to write modes as point data.
 //! * A series is written as `NAME_0000.vtu`, … and `NAME.pvd`.
 //!
 //! Not yet: superelements drawn as their FE mesh with the displacement field
-//! recovered from their modes, and beams extruded to their section.
+//! recovered from their modes (the `.se.ron` file holds no FE mesh and no
+//! recovery matrix), and beams extruded to their section.
 
 use flexmb_model::Mechanism;
 use std::fmt::Write as _;
@@ -137,12 +143,45 @@ fn data_array(
     out.push_str("\n        </DataArray>\n");
 }
 
+/// The node vectors (one 3-vector per node, z = 0 in a planar mechanism)
+/// of a vector `v` on the nodal coordinates: the node displacements of an
+/// increment Δx, e.g. a mode shape in nodal coordinates (the orientation
+/// coordinates are left out).
+pub fn node_vectors(mech: &Mechanism, v: &[f64]) -> Result<Vec<[f64; 3]>, VtkError> {
+    if v.len() != mech.n_x() {
+        return Err(VtkError::Size {
+            what: "the nodal vector".into(),
+            got: v.len(),
+            want: mech.n_x(),
+        });
+    }
+    Ok(positions(mech, v))
+}
+
+/// The largest length of the 3-vectors `v` (0 for none).
+pub fn largest_length(v: &[[f64; 3]]) -> f64 {
+    v.iter()
+        .map(|p| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt())
+        .fold(0.0, f64::max)
+}
+
 /// The VTU text of the mechanism at nodal coordinates `x`, with extra point
 /// vectors `point_data` (name, one 3-vector per node).
 pub fn configuration(
     mech: &Mechanism,
     x: &[f64],
     point_data: &[(&str, Vec<[f64; 3]>)],
+) -> Result<String, VtkError> {
+    configuration_with_fields(mech, x, point_data, &[])
+}
+
+/// [`configuration`] with field data: values of the whole data set (name,
+/// value), e.g. the frequency of a mode, in the VTU's `FieldData`.
+pub fn configuration_with_fields(
+    mech: &Mechanism,
+    x: &[f64],
+    point_data: &[(&str, Vec<[f64; 3]>)],
+    fields: &[(&str, f64)],
 ) -> Result<String, VtkError> {
     if x.len() != mech.n_x() {
         return Err(VtkError::Size {
@@ -155,6 +194,16 @@ pub fn configuration(
     let refs = reference(mech);
     let cells = cells(mech);
     let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n  <UnstructuredGrid>\n");
+    if !fields.is_empty() {
+        s.push_str("    <FieldData>\n");
+        for (name, v) in fields {
+            let _ = writeln!(
+                s,
+                "      <DataArray type=\"Float64\" Name=\"{name}\" NumberOfTuples=\"1\" format=\"ascii\">{v:e}</DataArray>"
+            );
+        }
+        s.push_str("    </FieldData>\n");
+    }
     let _ = writeln!(
         s,
         "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
@@ -263,13 +312,17 @@ pub fn configuration(
 
 /// A mode shape as `frames` configurations over one period: x0 + a sin(2πk/frames) Δx,
 /// with the amplitude `a` chosen so that the largest node displacement is
-/// `size` (m).
+/// `size` (m); the time value of frame k is its phase k/frames. Each frame
+/// has the point data `mode_shape`, the node displacements of a Δx (largest
+/// length `size`: ParaView's "warp by vector" with scale 1 shows the
+/// extreme), and the field data `fields` (e.g. the frequency).
 pub fn mode_frames(
     mech: &Mechanism,
     x0: &[f64],
     dx: &[f64],
     size: f64,
     frames: usize,
+    fields: &[(&str, f64)],
 ) -> Result<Vec<(f64, String)>, VtkError> {
     if dx.len() != mech.n_x() {
         return Err(VtkError::Size {
@@ -278,23 +331,17 @@ pub fn mode_frames(
             want: mech.n_x(),
         });
     }
-    let zero = vec![0.0; mech.n_x()];
     let d = positions(mech, dx);
-    let d0 = positions(mech, &zero);
-    let max = d
-        .iter()
-        .zip(&d0)
-        .map(|(p, q)| {
-            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
-        })
-        .fold(0.0f64, f64::max);
+    let max = largest_length(&d);
     let a = if max > 0.0 { size / max } else { 0.0 };
+    let shape: Vec<[f64; 3]> = d.iter().map(|p| p.map(|c| a * c)).collect();
     (0..frames.max(1))
         .map(|k| {
             let phase = k as f64 / frames.max(1) as f64;
             let s = a * (2.0 * std::f64::consts::PI * phase).sin();
             let x: Vec<f64> = x0.iter().zip(dx).map(|(x, d)| x + s * d).collect();
-            configuration(mech, &x, &[]).map(|t| (phase, t))
+            configuration_with_fields(mech, &x, &[("mode_shape", shape.clone())], fields)
+                .map(|t| (phase, t))
         })
         .collect()
 }

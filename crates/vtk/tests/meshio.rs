@@ -63,7 +63,8 @@ fn a_configuration_and_a_mode_series_read_back_with_meshio() {
     let speed = vec![[1.0, 2.0, 3.0]; mech.nodes.len()];
     let dir = std::env::temp_dir().join(format!("flexmb-vtk-{}", std::process::id()));
     let one = flexmb_vtk::configuration(&mech, &moved, &[("velocity", speed)]).unwrap();
-    let frames = flexmb_vtk::mode_frames(&mech, &x, &dx, 0.05, 8).unwrap();
+    let frames =
+        flexmb_vtk::mode_frames(&mech, &x, &dx, 0.05, 8, &[("frequency_hz", 12.5)]).unwrap();
     flexmb_vtk::write_series(&dir, "static", &[(0.0, one)]).unwrap();
     let files = flexmb_vtk::write_series(&dir, "mode1", &frames).unwrap();
     assert_eq!(files.len(), 9);
@@ -89,6 +90,12 @@ assert abs(ea[1] / 1e6 - 1) < 1e-9, ea
 # the mode series: a quarter period has the full 0.05 m at C
 q = meshio.read("{d}/mode1_0002.vtu")
 assert abs(np.linalg.norm(q.point_data["displacement"][2]) - 0.05) < 1e-12
+# every frame has the mode's node displacements, the largest 0.05 m, and its frequency
+for k in (0, 3):
+    f = meshio.read("{d}/mode1_%04d.vtu" % k)
+    assert np.allclose(f.point_data["mode_shape"][2], 0.05 * np.array([0.01, -0.02, 0.03]) / np.linalg.norm([0.01, -0.02, 0.03]), atol=1e-15), f.point_data
+    assert np.allclose(f.point_data["mode_shape"][0], 0), f.point_data
+    assert f.field_data["frequency_hz"].tolist() == [12.5], f.field_data
 t = [float(e.get("timestep")) for e in ET.parse("{d}/mode1.pvd").getroot().iter("DataSet")]
 assert t == [k / 8 for k in range(8)], t
 print("ok")
