@@ -103,6 +103,10 @@ impl Default for NewtonOptions {
 /// Kinematics failures, naming the coordinates involved.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum KinematicsError {
+    /// The stop request given to [`Kinematics::set_stop`] was set during a
+    /// position solve.
+    #[error("stopped on request")]
+    Interrupted,
     /// Newton did not converge.
     #[error("the position solve did not converge in {iterations} iterations (residual {residual:.3e}); largest residuals: {equations:?}; largest last updates: {coordinates:?}. {hint}")]
     NotConverged {
@@ -171,6 +175,9 @@ struct ElemMap {
 /// current configuration and all work buffers (allocated once).
 pub struct Kinematics {
     mech: Arc<Mechanism>,
+    /// A stop request read at every Newton iteration of the position
+    /// solve ([`set_stop`](Self::set_stop)).
+    stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     opts: NewtonOptions,
     maps: Vec<ElemMap>,
     /// global row of each deformation (if it is an equation)
@@ -345,6 +352,7 @@ impl Kinematics {
             .collect();
         let mut s = Self {
             opts: NewtonOptions::default(),
+            stop: None,
             maps,
             row_of,
             xi_of_x,
@@ -400,6 +408,15 @@ impl Kinematics {
     /// The Newton settings of the position solve.
     pub fn newton_options(&self) -> NewtonOptions {
         self.opts
+    }
+
+    /// Reads `stop` at every Newton iteration of the position solve, which
+    /// then ends with [`KinematicsError::Interrupted`] when it is set: an
+    /// implicit time step of a large model can spend a second in position
+    /// solves of iterates far from the solution. `None` (the default) never
+    /// stops.
+    pub fn set_stop(&mut self, stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
+        self.stop = stop;
     }
 
     /// Sets the Newton options.
@@ -806,6 +823,14 @@ impl Kinematics {
         let mut res = self.load_residual();
         let mut outcome = None;
         for it in 0..=self.opts.max_iterations {
+            if self
+                .stop
+                .as_ref()
+                .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+            {
+                self.last_update = last_update;
+                return Err(KinematicsError::Interrupted);
+            }
             if !res.is_finite() {
                 break;
             }
