@@ -67,7 +67,7 @@ impl<'a> MeshRecovery<'a> {
     pub fn positions(&mut self, x: &[f64], out: &mut [[f64; 3]]) -> Result<(), Error> {
         let n_x = self.n_coords();
         if x.len() != n_x || out.len() != self.mesh.nodes.len() {
-            return Err(Error::Spec(format!(
+            return Err(Error::SizeMismatch(format!(
                 "mesh recovery: {} element coordinates and {} output nodes given, expected {n_x} and {}",
                 x.len(),
                 out.len(),
