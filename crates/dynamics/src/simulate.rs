@@ -341,10 +341,14 @@ fn integrate_explicit_named<S: OdeSystem + ?Sized>(
 /// cause ([`DynamicsError::failed_evaluation`]).
 fn to_rhs_error(e: DynamicsError) -> RhsError {
     let kind = match e {
+        DynamicsError::Interrupted
+        | DynamicsError::Kinematics {
+            source: flexmb_kinematics::KinematicsError::Interrupted,
+            ..
+        } => RhsErrorKind::Interrupted,
         DynamicsError::Kinematics { .. } | DynamicsError::NonFinite { .. } => {
             RhsErrorKind::Recoverable
         }
-        DynamicsError::Interrupted => RhsErrorKind::Interrupted,
         _ => RhsErrorKind::Fatal,
     };
     RhsError::from_cause(kind, e)
@@ -805,6 +809,10 @@ impl Dynamics {
                     atol: Tolerance::Scalar(opts.atol),
                     ..Default::default()
                 };
+                // the position solves of the step's iterates read the stop
+                // request too (far from the solution one can take 30
+                // iterations: most of a second on the 1440-DOF chain)
+                self.kin.set_stop(opts.stop.clone());
                 let mut sys = Residual {
                     dy: self,
                     watch,
@@ -812,7 +820,7 @@ impl Dynamics {
                     stopped_at: None,
                 };
                 let mut last_output = f64::NEG_INFINITY;
-                let sol = match GeneralizedAlpha::new(o).solve_with(
+                let solved = GeneralizedAlpha::new(o).solve_with(
                     &mut sys,
                     t0,
                     q0,
@@ -823,7 +831,9 @@ impl Dynamics {
                         last_output = t;
                         emit(t, q, qd)
                     },
-                ) {
+                );
+                sys.dy.kin.set_stop(None);
+                let sol = match solved {
                     Ok(sol) => sol,
                     // the start-up mass matrix is singular: the projection's
                     // Mq names the degrees of freedom without inertia, as

@@ -61,7 +61,7 @@ pub use inertia::{VelocityTransform, MAX_MODES};
 pub use kernels::DeformationKernel;
 pub use kinetic::KineticEnergyKernel;
 pub use section::{rectangle_torsion_constant, Material, SectionProperties, SectionShape};
-pub use superelement::{LinearSuperelement, ModeKind, Provenance, Side};
+pub use superelement::{FeCell, FeMesh, LinearSuperelement, ModeKind, Provenance, Side};
 
 /// Errors of element construction. Messages name the property and what would fix it.
 #[derive(Debug, thiserror::Error, PartialEq)]

@@ -69,6 +69,41 @@ pub struct LinearSuperelement {
     /// Where the data came from.
     #[serde(default)]
     pub provenance: Provenance,
+    /// The FE mesh and its displacement recovery, if the builder wrote them
+    /// (files without it still load).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fe_mesh: Option<FeMesh>,
+}
+
+/// One cell of a superelement's FE mesh: its VTK cell type (10 tetra, 24
+/// quadratic tetra, 12 hexahedron, 25 quadratic hexahedron, 13 wedge, 26
+/// quadratic wedge) and its nodes (indices into [`FeMesh::nodes`]) in VTK order.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FeCell {
+    /// VTK cell type.
+    pub vtk_type: u8,
+    /// Node indices.
+    pub nodes: Vec<usize>,
+}
+
+/// The FE mesh of a superelement with the recovery of its displacement field
+/// (issue 21). Everything is in the element frame of the reference
+/// configuration: origin at node p, axes the columns of R0.
+///
+/// A node at X (element frame) moves, in the element frame, by Σ_c Φ_c ζ_c with
+/// ζ = (µ̄e, η̄) the coordinates of S̄ (thesis (3.6c)); see
+/// `flexmb_superelement::recovery` for the co-rotated placement.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FeMesh {
+    /// Reference node positions X (element frame, m).
+    pub nodes: Vec<[f64; 3]>,
+    /// The cells (none when the FE elements are not known).
+    pub cells: Vec<FeCell>,
+    /// Per node the 3 translations per coordinate ζ_c, coordinate-major:
+    /// `recovery[i][3 c + d]` is component d of Φ_c at node i; 3 (6 + k) per node.
+    pub recovery: Vec<Vec<f64>>,
 }
 
 impl LinearSuperelement {
@@ -124,6 +159,7 @@ impl LinearSuperelement {
             m_bar: rows(m_bar),
             modes,
             provenance: Provenance::default(),
+            fe_mesh: None,
         }
     }
 
@@ -176,6 +212,9 @@ impl LinearSuperelement {
                 "modes must be ordered: p-side interface modes, q-side interface modes, then normal modes".into(),
             ));
         }
+        if let Some(mesh) = &self.fe_mesh {
+            mesh.validate(6 + k)?;
+        }
         let r = nalgebra::Matrix3::from_fn(|i, j| self.r0[i][j]);
         if (r.transpose() * r - nalgebra::Matrix3::identity()).norm() > 1e-9
             || r.determinant() < 0.0
@@ -183,6 +222,42 @@ impl LinearSuperelement {
             return Err(ElementError::Superelement(
                 "R0 is not a rotation matrix".into(),
             ));
+        }
+        Ok(())
+    }
+}
+
+impl FeMesh {
+    /// Checks the sizes against `n_coords` = 6 + k coordinates, the cells'
+    /// node indices and finiteness. Errors name the node or cell.
+    pub fn validate(&self, n_coords: usize) -> Result<(), ElementError> {
+        let bad = |m: String| Err(ElementError::Superelement(format!("fe_mesh: {m}")));
+        let n = self.nodes.len();
+        if self.recovery.len() != n {
+            return bad(format!(
+                "{} recovery rows for {n} nodes",
+                self.recovery.len()
+            ));
+        }
+        for (i, (x, r)) in self.nodes.iter().zip(&self.recovery).enumerate() {
+            if r.len() != 3 * n_coords {
+                return bad(format!(
+                    "recovery row of node {i} has {} entries, expected 3 × {n_coords}",
+                    r.len()
+                ));
+            }
+            if x.iter().chain(r).any(|v| !v.is_finite()) {
+                return bad(format!(
+                    "node {i} has a non-finite position or recovery entry"
+                ));
+            }
+        }
+        for (c, cell) in self.cells.iter().enumerate() {
+            if let Some(&j) = cell.nodes.iter().find(|&&j| j >= n) {
+                return bad(format!(
+                    "cell {c} refers to node {j}, but there are {n} nodes"
+                ));
+            }
         }
         Ok(())
     }

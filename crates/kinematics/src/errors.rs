@@ -8,6 +8,10 @@ use crate::Kinematics;
 /// Kinematics failures, naming the coordinates involved.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum KinematicsError {
+    /// The stop request given to [`Kinematics::set_stop`] was set during a
+    /// position solve.
+    #[error("stopped on request")]
+    Interrupted,
     /// Newton did not converge.
     #[error("the position solve did not converge in {iterations} iterations (residual {residual:.3e}); largest residuals: {equations:?}; largest last updates: {coordinates:?}. {hint}")]
     NotConverged {

@@ -77,6 +77,9 @@ struct ElemMap {
 /// current configuration and all work buffers (allocated once).
 pub struct Kinematics {
     mech: Arc<Mechanism>,
+    /// A stop request read at every Newton iteration of the position
+    /// solve ([`set_stop`](Self::set_stop)).
+    stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     opts: NewtonOptions,
     maps: Vec<ElemMap>,
     /// global row of each deformation (if it is an equation)
@@ -149,6 +152,15 @@ impl Kinematics {
     /// The Newton settings of the position solve.
     pub fn newton_options(&self) -> NewtonOptions {
         self.opts
+    }
+
+    /// Reads `stop` at every Newton iteration of the position solve, which
+    /// then ends with [`KinematicsError::Interrupted`] when it is set: an
+    /// implicit time step of a large model can spend a second in position
+    /// solves of iterates far from the solution. `None` (the default) never
+    /// stops.
+    pub fn set_stop(&mut self, stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
+        self.stop = stop;
     }
 
     /// Sets the Newton options.

@@ -282,6 +282,14 @@ impl Kinematics {
         let mut res = self.load_residual();
         let mut outcome = None;
         for it in 0..=self.opts.max_iterations {
+            if self
+                .stop
+                .as_ref()
+                .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+            {
+                self.last_update = last_update;
+                return Err(KinematicsError::Interrupted);
+            }
             if !res.is_finite() {
                 break;
             }

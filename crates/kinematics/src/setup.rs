@@ -82,6 +82,7 @@ impl Kinematics {
             .collect();
         let mut s = Self {
             opts: NewtonOptions::default(),
+            stop: None,
             maps,
             row_of,
             xi_of_x,

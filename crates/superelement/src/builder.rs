@@ -22,7 +22,9 @@ use crate::model::{cross, dot, norm, sub, FeModel, NodeSelection};
 use crate::reduction::{Expansion, ExtOps, MassBlock, Problem};
 use crate::Error;
 use faer::Mat;
-use flexmb_element::{frame_from_axis, LinearSuperelement, ModeKind, Provenance, Side};
+use flexmb_element::{
+    frame_from_axis, FeCell, FeMesh, LinearSuperelement, ModeKind, Provenance, Side,
+};
 use flexmb_linalg::{generalized_eigen, lowest_eigenpairs, Definite};
 use nalgebra::{DMatrix, Matrix3};
 use serde::{Deserialize, Serialize};
@@ -118,6 +120,15 @@ pub struct BuildSettings {
     /// the mesh volume, when the volume is known); `None` disables it.
     #[serde(default = "default_density_range")]
     pub density_range: Option<[f64; 2]>,
+    /// Write the FE mesh and its displacement recovery into the superelement
+    /// data ([`flexmb_element::FeMesh`], for drawing the part as its mesh);
+    /// default true, false for large meshes.
+    #[serde(default = "default_fe_mesh")]
+    pub fe_mesh: bool,
+}
+
+fn default_fe_mesh() -> bool {
+    true
 }
 
 impl BuildSettings {
@@ -140,6 +151,7 @@ impl BuildSettings {
             normal_modes: 0,
             point_masses: Vec::new(),
             density_range: default_density_range(),
+            fe_mesh: default_fe_mesh(),
         }
     }
 }
@@ -1184,6 +1196,12 @@ pub fn build(model: &FeModel, s: &BuildSettings) -> Result<BuildResult, Error> {
         )],
         settings: settings_text(s, &ctx, &freqs),
     };
+    let eq_of_node: Vec<[Option<usize>; 3]> = (0..model.n_nodes())
+        .map(|i| model.dofs().node_eqs(i))
+        .collect();
+    if s.fe_mesh {
+        data.fe_mesh = Some(fe_mesh(&ctx, &shapes, &sel, &eq_of_node));
+    }
     data.validate()?;
     let report = BuildReport {
         n_eq: model.n_eq(),
@@ -1195,9 +1213,6 @@ pub fn build(model: &FeModel, s: &BuildSettings) -> Result<BuildResult, Error> {
         timings,
         material: crate::wave_speed::infer_material(model),
     };
-    let eq_of_node = (0..model.n_nodes())
-        .map(|i| model.dofs().node_eqs(i))
-        .collect();
     Ok(BuildResult {
         data,
         k_full,
@@ -1205,6 +1220,53 @@ pub fn build(model: &FeModel, s: &BuildSettings) -> Result<BuildResult, Error> {
         report,
         eq_of_node,
     })
+}
+
+/// The FE mesh in the element frame (origin p, axes R0) with the recovery
+/// R0ᵀ [Ve W] of every node's translations over the S̄ coordinates `sel`.
+fn fe_mesh(
+    ctx: &Ctx<'_>,
+    shapes: &Mat<f64>,
+    sel: &[usize],
+    eq_of_node: &[[Option<usize>; 3]],
+) -> FeMesh {
+    let r0 = &ctx.r0;
+    let local = |g: [f64; 3]| -> [f64; 3] {
+        std::array::from_fn(|a| (0..3).map(|r| r0[r][a] * g[r]).sum())
+    };
+    let nodes = ctx
+        .model
+        .coords()
+        .iter()
+        .map(|&x| local(sub(x, ctx.rb[0])))
+        .collect();
+    let recovery = eq_of_node
+        .iter()
+        .map(|e| {
+            sel.iter()
+                .flat_map(|&c| {
+                    local(std::array::from_fn(|d| {
+                        e[d].map_or(0.0, |r| shapes[(r, c)])
+                    }))
+                })
+                .collect()
+        })
+        .collect();
+    let cells = ctx.model.solid.as_ref().map_or_else(Vec::new, |sol| {
+        sol.kinds
+            .iter()
+            .zip(&sol.nodes)
+            .map(|(k, n)| FeCell {
+                vtk_type: k.vtk_type(),
+                nodes: n.clone(),
+            })
+            .collect()
+    });
+    FeMesh {
+        nodes,
+        cells,
+        recovery,
+    }
 }
 
 fn settings_text(s: &BuildSettings, ctx: &Ctx<'_>, freqs: &[f64]) -> Vec<String> {

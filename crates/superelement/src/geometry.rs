@@ -60,6 +60,19 @@ impl SolidKind {
             SolidKind::Wedge15 => 15,
         }
     }
+
+    /// The VTK cell type with the same node order (the Abaqus/CalculiX order of
+    /// corners, then edge midsides, is VTK's for these kinds).
+    pub fn vtk_type(self) -> u8 {
+        match self {
+            SolidKind::Tet4 => 10,
+            SolidKind::Tet10 => 24,
+            SolidKind::Hex8 => 12,
+            SolidKind::Hex20 => 25,
+            SolidKind::Wedge6 => 13,
+            SolidKind::Wedge15 => 26,
+        }
+    }
 }
 
 /// Volume moments about a point c: ∫ dV, ∫ (x − c) dV, ∫ (x − c)(x − c)ᵀ dV.

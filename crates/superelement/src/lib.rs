@@ -63,6 +63,7 @@ pub mod harwell_boeing;
 mod model;
 pub mod parts;
 pub mod readers;
+pub mod recovery;
 mod reduction;
 pub mod solid;
 pub mod spec;

@@ -21,8 +21,10 @@
 //! * A series is written as `NAME_0000.vtu`, … and `NAME.pvd`.
 //!
 //! Not yet: superelements drawn as their FE mesh with the displacement field
-//! recovered from their modes (the `.se.ron` file holds no FE mesh and no
-//! recovery matrix), and beams extruded to their section.
+//! recovered from their modes (the `.se.ron` file now holds the mesh and its
+//! recovery, `flexmb_element::FeMesh`, placed by
+//! `flexmb_superelement::recovery::MeshRecovery`; this writer does not use
+//! them yet and draws the chord), and beams extruded to their section.
 
 use flexmb_model::Mechanism;
 use std::fmt::Write as _;
