@@ -344,19 +344,18 @@ mod tests {
         }
     }
 
-    fn random_system(dense_up_to: usize) {
-        let n = 30;
-        let mut entries = vec![];
-        let mut vals = vec![];
-        let mut seed = 7u64;
+    /// The entries and values of a random n × n sparse matrix: a permuted
+    /// diagonal (it forces row pivoting) and three random entries per row.
+    fn random_entries(n: usize, mut seed: u64) -> (Vec<(usize, usize)>, Vec<f64>) {
         let mut rnd = || {
             seed = seed
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
         };
+        let mut entries = vec![];
+        let mut vals = vec![];
         for i in 0..n {
-            // a permuted diagonal forces row pivoting
             entries.push((i, (i * 7) % n));
             vals.push(3.0 + rnd());
             for _ in 0..3 {
@@ -365,6 +364,12 @@ mod tests {
                 vals.push(rnd());
             }
         }
+        (entries, vals)
+    }
+
+    fn random_system(dense_up_to: usize) {
+        let n = 30;
+        let (entries, vals) = random_entries(n, 7);
         let (mut lu, pos) = JacobianLu::with_dense_limit(n, &entries, dense_up_to);
         lu.values_mut().fill(0.0);
         for (p, v) in pos.iter().zip(&vals) {
@@ -388,24 +393,7 @@ mod tests {
     #[test]
     fn the_smallest_pivot_names_a_nearly_zero_column() {
         let n = 30;
-        let mut seed = 11u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
-        let mut entries = vec![];
-        let mut vals = vec![];
-        for i in 0..n {
-            entries.push((i, (i * 7) % n));
-            vals.push(3.0 + rnd());
-            for _ in 0..3 {
-                let j = ((rnd() + 0.5) * n as f64) as usize % n;
-                entries.push((i, j));
-                vals.push(rnd());
-            }
-        }
+        let (entries, vals) = random_entries(n, 11);
         for tiny in [4, 17, 29] {
             let (mut lu, pos) = JacobianLu::with_dense_limit(n, &entries, 0);
             lu.values_mut().fill(0.0);
