@@ -209,16 +209,19 @@ fn signal_stops_a_simulation(signal: &str, code: i32, integrator: &str) {
 
 #[test]
 fn sigint_stops_a_simulation_between_steps_with_partial_results_and_exit_130() {
+    let _one_at_a_time = one_at_a_time();
     signal_stops_a_simulation("INT", 130, "dopri5");
 }
 
 #[test]
 fn sigterm_stops_a_simulation_between_steps_with_partial_results_and_exit_143() {
+    let _one_at_a_time = one_at_a_time();
     signal_stops_a_simulation("TERM", 143, "adams");
 }
 
 #[test]
 fn sigint_stops_the_implicit_integrator_between_steps_too() {
+    let _one_at_a_time = one_at_a_time();
     signal_stops_a_simulation("INT", 130, "genalpha");
 }
 
@@ -228,6 +231,7 @@ fn sigint_stops_the_implicit_integrator_between_steps_too() {
 /// them: the tests above.)
 #[test]
 fn a_second_signal_exits_at_once() {
+    let _one_at_a_time = one_at_a_time();
     let out = temp_dir("twice");
     let mut child = long_simulation(&out, "dopri5");
     let _stdout = wait_until_computing(&mut child, Duration::from_millis(300));
@@ -250,6 +254,7 @@ fn a_second_signal_exits_at_once() {
 /// has the configurations of the CSV.
 #[test]
 fn an_interrupted_sweep_stops_at_once_and_says_what_was_written() {
+    let _one_at_a_time = one_at_a_time();
     let out = temp_dir("sweep");
     let vtk = temp_dir("sweep-vtk");
     let scene = fixture("straight_guidance_spatial.ron");
@@ -295,6 +300,7 @@ fn an_interrupted_sweep_stops_at_once_and_says_what_was_written() {
 /// writes no model.
 #[test]
 fn an_interrupted_reduction_exits_at_once_without_a_model() {
+    let _one_at_a_time = one_at_a_time();
     let dir = temp_dir("reduce");
     std::fs::create_dir_all(&dir).unwrap();
     let model = dir.join("model.ron");
@@ -335,6 +341,7 @@ fn an_interrupted_reduction_exits_at_once_without_a_model() {
 /// to be exit code 101, "failed printing to stdout"), exit code 0.
 #[test]
 fn a_closed_stdout_is_no_panic_and_no_error() {
+    let _one_at_a_time = one_at_a_time();
     let scene = fixture("straight_guidance_spatial.ron");
     let mut child = Command::new(env!("CARGO_BIN_EXE_flexmb"))
         .arg("info")
@@ -354,6 +361,7 @@ fn a_closed_stdout_is_no_panic_and_no_error() {
 /// with both stdout and stderr closed still gives its exit code.
 #[test]
 fn a_closed_stdout_does_not_stop_the_files_or_change_the_exit_code() {
+    let _one_at_a_time = one_at_a_time();
     let out = temp_dir("pipe");
     let scene = fixture("straight_guidance_planar.ron");
     let mut child = Command::new(env!("CARGO_BIN_EXE_flexmb"))
@@ -391,6 +399,7 @@ fn a_closed_stdout_does_not_stop_the_files_or_change_the_exit_code() {
 /// the configurations reported, and the file says it is partial.
 #[test]
 fn an_interrupted_reduced_sweep_exits_143_with_the_partial_frequencies() {
+    let _one_at_a_time = one_at_a_time();
     let dir = temp_dir("reduced-sweep");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = fixture("straight_guidance_planar.ron");
@@ -451,24 +460,29 @@ fn an_interrupted_reduced_sweep_exits_143_with_the_partial_frequencies() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// The tests that run the 1440-DOF chain take one at a time: each keeps
-/// both cores busy, and a stop latency measured while another one runs
-/// measures the contention (two of them in parallel on this 2-core machine,
-/// under a concurrent build, missed the 1 s backstop).
-static ONE_LARGE_MODEL_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+/// The tests of this file run one at a time: each measures a stop latency,
+/// and one measured while another test keeps the cores busy measures the
+/// contention (two 1440-DOF tests in parallel on this 2-core machine, under
+/// a concurrent build, missed the 1 s backstop; the sweep of that chain,
+/// next to the other tests here on the CI machine, stopped 464 ms after the
+/// signal).
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Holds [`ONE_AT_A_TIME`] until the test ends.
+fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
 
 /// The flexure chain with its beams split in 20 (1440 degrees of freedom),
-/// written to `dir`; the guard of [`ONE_LARGE_MODEL_AT_A_TIME`] is held
-/// until the test ends.
-fn chain_1440(dir: &Path) -> (PathBuf, std::sync::MutexGuard<'static, ()>) {
-    let guard = ONE_LARGE_MODEL_AT_A_TIME
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner());
+/// written to `dir`.
+fn chain_1440(dir: &Path) -> PathBuf {
     let text = std::fs::read_to_string(fixture("flexure_chain_720.ron")).unwrap();
     assert_eq!(text.matches("n: 10)").count(), 12, "the fixture changed");
     let scene = dir.join("chain_1440.ron");
     std::fs::write(&scene, text.replace("n: 10)", "n: 20)")).unwrap();
-    (scene, guard)
+    scene
 }
 
 /// The stop latency we accept for the 1440-DOF chain, from the signal to the
@@ -492,9 +506,10 @@ const CHAIN_STOP_WITHIN_MS: f64 = 350.0;
 /// written.
 #[test]
 fn an_interrupted_sweep_of_a_large_model_stops_inside_the_eigen_analysis() {
+    let _one_at_a_time = one_at_a_time();
     let dir = temp_dir("large-sweep");
     std::fs::create_dir_all(&dir).unwrap();
-    let (scene, _one_at_a_time) = chain_1440(&dir);
+    let scene = chain_1440(&dir);
     let args = [
         "sweep",
         scene.to_str().unwrap(),
@@ -567,9 +582,10 @@ fn an_interrupted_sweep_of_a_large_model_stops_inside_the_eigen_analysis() {
 /// on a loaded machine), or 40 s if the set-up was still running.
 #[test]
 fn an_interrupted_implicit_run_of_a_large_model_stops_inside_the_step() {
+    let _one_at_a_time = one_at_a_time();
     let dir = temp_dir("large-genalpha");
     std::fs::create_dir_all(&dir).unwrap();
-    let (scene, _one_at_a_time) = chain_1440(&dir);
+    let scene = chain_1440(&dir);
     let args = [
         "simulate",
         scene.to_str().unwrap(),
@@ -624,9 +640,10 @@ fn an_interrupted_implicit_run_of_a_large_model_stops_inside_the_step() {
 /// linearizations and eigen analyses of a few modes: see the tests above.)
 #[test]
 fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
+    let _one_at_a_time = one_at_a_time();
     let dir = temp_dir("backstop");
     std::fs::create_dir_all(&dir).unwrap();
-    let (scene, _one_at_a_time) = chain_1440(&dir);
+    let scene = chain_1440(&dir);
     let args = [
         "sweep",
         scene.to_str().unwrap(),
