@@ -9,7 +9,8 @@
 //!   there, and the command writes what it has, then exits with 128 + the
 //!   signal number (130 for SIGINT, 143 for SIGTERM). If the computation has
 //!   not reached such a check [`GRACE`] after the signal (one very long
-//!   step), the process exits with that code without writing;
+//!   step; [`GRACE_VAR`] sets another time), the process exits with that
+//!   code without writing;
 //! * in any other phase (reading and building the scene, `static`, `eig`,
 //!   `reduce`, an equilibrium before a simulation), there is nothing partial
 //!   to write: the process exits at once with that code;
@@ -31,8 +32,43 @@ use std::sync::atomic::{AtomicBool, AtomicI32, AtomicU32, AtomicU64, AtomicU8, O
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
-/// How long a stoppable phase has to reach its next check after a signal.
+/// How long a stoppable phase has to reach its next check after a signal,
+/// unless [`GRACE_VAR`] says otherwise.
 pub(crate) const GRACE: Duration = Duration::from_secs(1);
+
+/// The environment variable that sets the grace time, in seconds (a
+/// positive number, at most an hour): a scheduler that kills after a few
+/// seconds wants a shorter one, the tests of the backstop a short one so
+/// that any long computation triggers it.
+pub(crate) const GRACE_VAR: &str = "FLEXMB_STOP_GRACE";
+
+/// The grace time in force: [`GRACE`] or [`GRACE_VAR`]'s, in ns.
+static GRACE_NS: AtomicU64 = AtomicU64::new(GRACE.as_nanos() as u64);
+
+/// The grace time in force.
+fn grace() -> Duration {
+    Duration::from_nanos(GRACE_NS.load(Ordering::Relaxed))
+}
+
+/// Reads the grace time from [`GRACE_VAR`], if it is set; an error names
+/// the variable and its value.
+pub(crate) fn grace_from_env() -> Result<(), String> {
+    let Some(value) = std::env::var_os(GRACE_VAR) else {
+        return Ok(());
+    };
+    let text = value.to_string_lossy();
+    let seconds: f64 = text.trim().parse().map_err(|_| {
+        format!("{GRACE_VAR}={text:?} is not a number of seconds (e.g. {GRACE_VAR}=0.5)")
+    })?;
+    if !(seconds > 0.0 && seconds <= 3600.0) {
+        return Err(format!(
+            "{GRACE_VAR}={text:?}: the grace time must be more than 0 s and at most 3600 s"
+        ));
+    }
+    let ns = Duration::from_secs_f64(seconds).as_nanos().max(1);
+    GRACE_NS.store(u64::try_from(ns).unwrap_or(u64::MAX), Ordering::Relaxed);
+    Ok(())
+}
 
 /// The phase: exit at once on the first signal.
 const EXIT_AT_ONCE: u8 = 0;
@@ -179,12 +215,12 @@ fn on_signal(sig: i32) {
         EXIT_AT_ONCE => leave(sig, "nothing partial to write"),
         STOP_AT_CHECK => {
             while PHASE.load(Ordering::SeqCst) == STOP_AT_CHECK {
-                if at.elapsed() > GRACE {
+                if at.elapsed() > grace() {
                     leave(
                         sig,
                         &format!(
                             "the computation reached no point to stop at within {} s; nothing written",
-                            GRACE.as_secs_f64()
+                            grace().as_secs_f64()
                         ),
                     );
                 }

@@ -254,6 +254,9 @@ fn io_err(e: std::io::Error, what: &Path) -> Failure {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = interrupt::grace_from_env() {
+        return exit_code(Err(Failure::Input(e)));
+    }
     if let Err(e) = interrupt::install() {
         errln(&format!(
             "warning: cannot handle SIGINT and SIGTERM ({e}): a signal ends the run without partial results"

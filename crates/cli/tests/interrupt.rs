@@ -28,7 +28,13 @@ fn temp_dir(name: &str) -> PathBuf {
 
 /// Starts `flexmb args...` with stdout and stderr piped.
 fn start(args: &[&str], out: &Path) -> Child {
+    start_with(args, out, &[])
+}
+
+/// Starts `flexmb` like [`start`], with these environment variables.
+fn start_with(args: &[&str], out: &Path, env: &[(&str, &str)]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_flexmb"))
+        .envs(env.iter().copied())
         .args(args)
         .arg("--out")
         .arg(out)
@@ -626,18 +632,22 @@ fn an_interrupted_implicit_run_of_a_large_model_stops_inside_the_step() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// The backstop: a stoppable phase that reaches no check within 1 s of the
-/// signal is forced out with the signal's code, writing nothing. A sweep of
-/// the 1440-DOF flexure chain with 1000 modes per configuration, 40 load
-/// scales: each is a dense generalized eigen decomposition of the whole
-/// model (faer's, with no check inside), 0.5–2 s, so SIGINT 2 s after the
-/// summary comes in one of them (4 configurations finished within 2 s on
-/// the idle CI machine), unless the set-up and first equilibria are
-/// still running (they stop at once) or the signal comes between two
-/// decompositions (a clean stop): then again with a later signal, at most
-/// three times. (Before their stop checks, a generalized-α step's tangent
-/// and residual of this model were the trigger, and before that the
-/// linearizations and eigen analyses of a few modes: see the tests above.)
+/// The backstop: a stoppable phase that reaches no check within the grace
+/// time of the signal is forced out with the signal's code, writing
+/// nothing. The grace time is set to 50 ms (`FLEXMB_STOP_GRACE`), so that
+/// any computation without a check inside that takes longer triggers it:
+/// here a sweep of the 1440-DOF flexure chain with 1000 modes per
+/// configuration, 40 load scales, each a dense generalized eigen
+/// decomposition of the whole model (faer's, with no check inside), which
+/// took 0.3–1 s on the CI machines. SIGINT comes 2 s after the summary;
+/// if it still lands between two checks less than 50 ms apart (a clean
+/// stop), again with a later signal, at most three times. (With the
+/// default 1 s, the decompositions of the CI machine were too short to
+/// show the backstop: the signal came in one and it stopped 87–328 ms
+/// later, at the next check. Before their stop checks, a generalized-α
+/// step's tangent and residual of this model were the trigger, and before
+/// that the linearizations and eigen analyses of a few modes: see the
+/// tests above.)
 #[test]
 fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
     let _one_at_a_time = one_at_a_time();
@@ -662,10 +672,9 @@ fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
     let mut tries = vec![];
     for delay in [2, 4, 7] {
         let _ = std::fs::remove_dir_all(&out);
-        let mut child = start(&args, &out);
+        let mut child = start_with(&args, &out, &[("FLEXMB_STOP_GRACE", "0.05")]);
         let _stdout = wait_until_computing(&mut child, Duration::from_secs(delay));
         send(&child, "INT");
-        // the grace time, then teardown
         let (status, took, err) = wait_for_exit(&mut child, Duration::from_secs(3));
         if status.code() == Some(0) {
             // a fast machine finished the sweep before the signal
@@ -673,8 +682,8 @@ fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
             break;
         }
         assert_eq!(status.code(), Some(130), "{err}");
-        if err.contains("reached no point to stop at within 1 s; nothing written") {
-            assert!(took >= Duration::from_secs(1), "{took:?}: {err}");
+        if err.contains("reached no point to stop at within 0.05 s; nothing written") {
+            assert!(took >= Duration::from_millis(50), "{took:?}: {err}");
             assert!(!out.join("eigenfrequencies.csv").exists(), "{err}");
             let _ = std::fs::remove_dir_all(&dir);
             return;
@@ -687,5 +696,25 @@ fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
         );
         tries.push(format!("{delay} s: {}", err.trim()));
     }
-    panic!("no signal came inside an eigen decomposition: {tries:#?}");
+    panic!("no signal came inside a computation without checks: {tries:#?}");
+}
+
+/// A grace time that is not a positive number of seconds is an input
+/// error that names the variable and the value, before anything runs.
+#[test]
+fn a_bad_grace_time_is_an_error_that_names_the_variable() {
+    for bad in ["abc", "0", "-1", "NaN", "1e9"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_flexmb"))
+            .env("FLEXMB_STOP_GRACE", bad)
+            .args(["info", "no-such-scene.ron"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {err}");
+        assert!(
+            err.contains(&format!("FLEXMB_STOP_GRACE=\"{bad}\"")),
+            "{bad}: {err}"
+        );
+        assert!(!err.contains("no-such-scene"), "{bad}: {err}");
+    }
 }
