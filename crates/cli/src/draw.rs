@@ -5,6 +5,7 @@
 use crate::{coords, load, options, Failure};
 use clap::Args;
 use flexmb_draw::{Configuration, DrawError, DrawOptions, View};
+use flexmb_dynamics::{Dynamics, OutputTable};
 use flexmb_model::Mechanism;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -16,8 +17,9 @@ pub(crate) struct DrawArgs {
     scene: PathBuf,
     /// Draw this state: a CSV file whose columns are degrees of freedom
     /// (named as `flexmb info` prints them, or `q:NAME` as `simulate`
-    /// writes them) and optionally `t`; its last row is drawn, degrees of
-    /// freedom it does not list keep their reference values.
+    /// writes them with `Dofs` among the scene's outputs), the scene's other
+    /// output columns (passed over) and optionally `t`; its last row is
+    /// drawn, degrees of freedom it does not list keep their reference values.
     #[arg(long, value_name = "FILE.csv", conflicts_with = "static_first")]
     state: Option<PathBuf>,
     /// Draw the static equilibrium under the scene's loads and gravity at t = 0.
@@ -102,7 +104,11 @@ pub(crate) fn draw(a: &DrawArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The degrees of freedom of the state file `file` (see [`DrawArgs`]).
+/// The degrees of freedom of the state file `file` (see [`DrawArgs`]): its
+/// DOF columns (`NAME` or `q:NAME`). Columns that `simulate` writes for the
+/// scene's other `outputs` (positions, energies, …) are passed over; they
+/// do not fix a configuration. Any other column is an error, and so is a
+/// file without a DOF column (it would draw the reference silently).
 fn read_state(mech: &Arc<Mechanism>, file: &Path) -> Result<Vec<f64>, Failure> {
     let bad = |m: String| Failure::Input(format!("--state {}: {m}", file.display()));
     let (header, rows) = flexmb_plot::read_csv(file).map_err(|e| bad(e.to_string()))?;
@@ -116,17 +122,38 @@ fn read_state(mech: &Arc<Mechanism>, file: &Path) -> Result<Vec<f64>, Failure> {
             header.len()
         )));
     }
+    let outputs = OutputTable::new(&Dynamics::new(mech.clone()))
+        .map_err(|e| bad(e.to_string()))?
+        .header;
     let mut q = mech.q0();
+    let mut dofs_read = 0;
+    let mut passed_over = vec![];
     for (name, v) in header.iter().zip(last) {
         if name == "t" {
             continue;
         }
+        let dof = name.strip_prefix("q:").unwrap_or(name);
+        let is_dof = mech.dofs.iter().any(|c| mech.coordinate_name(*c) == dof);
+        if !is_dof && outputs.iter().any(|o| o == name) {
+            passed_over.push(name.as_str());
+            continue;
+        }
+        let k = coords::dof_index(mech, dof, &format!("--state {}:", file.display()))?;
         if !v.is_finite() {
             return Err(bad(format!("{name} is {v}")));
         }
-        let dof = name.strip_prefix("q:").unwrap_or(name);
-        let k = coords::dof_index(mech, dof, &format!("--state {}:", file.display()))?;
         q[k] = *v;
+        dofs_read += 1;
+    }
+    if dofs_read == 0 {
+        return Err(bad(if passed_over.is_empty() {
+            "no degree-of-freedom column (`flexmb info SCENE` lists them)".to_string()
+        } else {
+            format!(
+                "no degree-of-freedom column, only the scene's outputs {passed_over:?}, which do not \
+                 fix a configuration: add `Dofs` to the scene's `outputs` and run `simulate` again"
+            )
+        }));
     }
     Ok(q)
 }

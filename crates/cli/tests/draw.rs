@@ -125,3 +125,81 @@ fn draw_writes_the_figure_of_a_state_or_a_mode() {
     assert_ne!(a, b, "the state is not drawn");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--state` takes a `simulate` output file: its DOF columns (`q:NAME`,
+/// from `Dofs` among the scene's outputs) fix the configuration, its other
+/// output columns (`S.x`, `S.y`) are passed over. A file with only the
+/// outputs is an error that says to add `Dofs`, and a column that is
+/// neither a DOF nor an output of the scene is an error that names it.
+#[test]
+fn draw_takes_the_state_from_a_simulate_output_file() {
+    let dir = temp_dir("draw", "simulated");
+    let text = std::fs::read_to_string(fixture("straight_guidance_planar.ron")).unwrap();
+    let with_dofs = text.replace(
+        "outputs: [Position(\"S\")]",
+        "outputs: [Position(\"S\"), Dofs]",
+    );
+    assert_ne!(with_dofs, text, "the fixture's outputs changed");
+    let draw = |scene: &std::path::Path, state: &std::path::Path, fig: &str| {
+        flexmb()
+            .args(["draw"])
+            .arg(scene)
+            .arg("--state")
+            .arg(state)
+            .arg("--out")
+            .arg(dir.join(fig))
+            .output()
+            .unwrap()
+    };
+    let mut results = vec![];
+    for (name, scene_text) in [("outputs", &text), ("dofs", &with_dofs)] {
+        let scene = dir.join(format!("{name}.ron"));
+        std::fs::write(&scene, scene_text).unwrap();
+        let out = dir.join(name);
+        let o = flexmb()
+            .args(["simulate"])
+            .arg(&scene)
+            .args(["--t-end", "0.05", "--outputs", "3", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let csv = out.join("outputs.csv");
+        let (header, _) = flexmb_plot::read_csv(&csv).unwrap();
+        assert!(header.iter().any(|h| h == "S.x"), "{header:?}");
+        results.push((scene, csv, header));
+    }
+    // only the outputs: no configuration to draw
+    let (scene, csv, _) = &results[0];
+    let o = draw(scene, csv, "outputs.svg");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("add `Dofs`") && err.contains("S.x"), "{err}");
+    // with the DOFs: drawn, and not the reference
+    let (scene, csv, header) = &results[1];
+    assert!(header.iter().any(|h| h.starts_with("q:")), "{header:?}");
+    let o = draw(scene, csv, "dofs.svg");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = flexmb()
+        .args(["draw"])
+        .arg(scene)
+        .arg("--out")
+        .arg(dir.join("reference.svg"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let drawn = std::fs::read_to_string(dir.join("dofs.svg")).unwrap();
+    let reference = std::fs::read_to_string(dir.join("reference.svg")).unwrap();
+    assert_ne!(drawn, reference, "the simulated state is not drawn");
+    // a misspelt column is named
+    let bad = dir.join("bad.csv");
+    let body = std::fs::read_to_string(csv)
+        .unwrap()
+        .replacen("S.x", "S.xx", 1);
+    std::fs::write(&bad, body).unwrap();
+    let o = draw(scene, &bad, "bad.svg");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("'S.xx'"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
