@@ -123,3 +123,31 @@ fn only_b1_is_sensitive_to_reversing_the_elements() {
         d2.max(d3)
     );
 }
+
+/// The configuration a run keeps for its picture is the one at its largest
+/// |Δy′|, as the run reached it: Δy′ recomputed from its nodal coordinates
+/// and the spin angle at its time is the run's maximum, and the picture
+/// puts the tip there.
+#[test]
+fn the_spin_up_picture_shows_the_largest_deflection() {
+    let dir = temp_dir("picture");
+    let scene = spin_up::beam_scene(4, false);
+    let tip = spin_up::run(&scene, &dir, Integration::table(1e-6)).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let at = &tip.at_max;
+    let mech = &at.mechanism;
+    let spin = mech.inputs[0].function.value(at.t);
+    let t_node = mech.node("T").unwrap();
+    let (x, y) = (at.x[t_node.position[0]], at.x[t_node.position[1]]);
+    let dy = -spin.sin() * x + spin.cos() * y;
+    assert!(
+        (dy.abs() - tip.max()).abs() <= 1e-12 * tip.max(),
+        "Δy′ at the kept configuration {dy} (t = {}), the run's maximum {}",
+        at.t,
+        tip.max()
+    );
+    assert!(at.t > 0.0, "the largest deflection is not at the start");
+    let k = mech.nodes.iter().position(|n| n.id == "T").unwrap();
+    let drawn = flexmb_draw::node_positions(mech, &at.x)[k];
+    assert_eq!([drawn[0], drawn[1]], [x, y]);
+}

@@ -2,6 +2,7 @@
 //! x from node N0 at the origin to the tip T, and a run from rest in the
 //! reference configuration.
 
+use flexmb_draw::Configuration;
 use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions, Trajectory};
 use flexmb_model::{Mechanism, Scene};
 use std::path::Path;
@@ -50,6 +51,20 @@ pub struct Run {
 }
 
 impl Run {
+    /// The configuration at output `k` as the run reached it (its nodal
+    /// coordinates x, not solved again from q, which can land on a mirrored
+    /// branch of a chain that turned far), to draw.
+    pub fn configuration(&self, k: usize) -> Configuration {
+        let tr = &self.trajectory;
+        Configuration {
+            mechanism: self.mech.clone(),
+            q: tr.q[k].clone(),
+            x: tr.x[k].clone(),
+            t: tr.t[k],
+            load_scale: 1.0,
+        }
+    }
+
     /// The indices of node `id`'s position coordinates.
     pub fn position_of(&self, id: &str) -> Result<Vec<usize>, String> {
         Ok(self
@@ -84,4 +99,16 @@ pub fn run_from_rest(
         .simulate(0.0, &q0, &qd0, &opts, |_, _, _| Control::Continue)
         .map_err(|e| format!("{}: {e}", mech.name))?;
     Ok(Run { mech, trajectory })
+}
+
+/// The index of the largest of `values` by `size` (0 for none).
+pub fn index_of_largest<T>(values: &[T], size: impl Fn(&T) -> f64) -> usize {
+    let mut best = (0, f64::NEG_INFINITY);
+    for (k, v) in values.iter().enumerate() {
+        let m = size(v);
+        if m > best.1 {
+            best = (k, m);
+        }
+    }
+    best.0
 }

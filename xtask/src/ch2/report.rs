@@ -630,6 +630,23 @@ fn spin_up_section(
     }
     fig.save(out, "spin_up_tip", figs)?;
     md.push_str(&figs.markdown(|s| s == "spin_up_tip"));
+    let pictures = [
+        (beams, "mech_spin_up_beams"),
+        (Kind::Superelement(B3), "mech_spin_up_b3"),
+    ];
+    let mut drawn = vec![];
+    for (k, stem) in pictures {
+        if let Some(x) = r.spin(k, 4, spin_up::MESH, Integrator::Dopri5) {
+            let at = &x.tip.at_max;
+            let title = format!("{}, 4 elements, at t = {:.2} s", k.label(), at.t);
+            mechanism_picture(out, figs, stem, at, &title, Some(flexmb_draw::View::Xy))?;
+            drawn.push(stem);
+        }
+    }
+    if !drawn.is_empty() {
+        let _ = writeln!(md, "\nThe mechanism at the output of its largest |Δy′| (drawn by `flexmb_draw` from the run's own nodal coordinates; the reference configuration, along x, in grey):\n");
+        md.push_str(&figs.markdown(|s| drawn.contains(&s)));
+    }
 
     // speed against error rows
     let mut rows = vec![];
@@ -761,6 +778,26 @@ pub fn uj_claims(r: &Results) -> Option<UjClaims> {
     })
 }
 
+/// Draws `at` with the reference configuration overlaid, as
+/// `out/stem.svg` and `.png`.
+fn mechanism_picture(
+    out: &Path,
+    figs: &mut Figures,
+    stem: &str,
+    at: &flexmb_draw::Configuration,
+    title: &str,
+    view: Option<flexmb_draw::View>,
+) -> Result<(), String> {
+    let opts = flexmb_draw::DrawOptions {
+        view,
+        reference: true,
+        title: Some(title.into()),
+        ..Default::default()
+    };
+    crate::pictures::save(figs, out, stem, at, &opts).map_err(io)?;
+    Ok(())
+}
+
 fn uj_section(out: &Path, r: &Results, md: &mut String, figs: &mut Figures) -> Result<(), String> {
     let _ = writeln!(
         md,
@@ -793,6 +830,13 @@ fn uj_section(out: &Path, r: &Results, md: &mut String, figs: &mut Figures) -> R
         }
     }
     md.push_str(&t.render());
+    if let Some(x) = r.uj_run(uj::MODELS[0], false, rtol) {
+        let at = &x.tip.at_max;
+        let title = format!("{}, at t = {:.2} s", uj::MODELS[0].label(), at.t);
+        mechanism_picture(out, figs, "mech_uj", at, &title, None)?;
+        let _ = writeln!(md, "\nThe {} model at the output of its largest lag |Δz′| (isometric, y up; the reference configuration, along x, in grey):\n", uj::MODELS[0].label());
+        md.push_str(&figs.markdown(|s| s == "mech_uj"));
+    }
     if let Some(c) = uj_claims(r) {
         let _ = writeln!(
             md,

@@ -7,6 +7,7 @@
 
 use super::chain;
 use super::segments::{self, Built, SegmentMesh};
+use flexmb_draw::Configuration;
 use flexmb_dynamics::Integrator;
 use flexmb_element::VelocityTransform;
 use std::path::Path;
@@ -149,6 +150,8 @@ pub struct TipHistory {
     pub wall_time: f64,
     /// Degrees of freedom.
     pub dof: usize,
+    /// The configuration at the output of the largest |Δy′|, to draw.
+    pub at_max: Configuration,
 }
 
 impl TipHistory {
@@ -211,7 +214,7 @@ pub fn run(scene: &str, dir: &Path, how: Integration) -> Result<TipHistory, Stri
         .function
         .clone();
     let tr = &r.trajectory;
-    let dy =
+    let dy: Vec<f64> =
         tr.t.iter()
             .zip(&tr.x)
             .map(|(t, x)| {
@@ -219,9 +222,11 @@ pub fn run(scene: &str, dir: &Path, how: Integration) -> Result<TipHistory, Stri
                 -e.sin() * x[tip[0]] + e.cos() * x[tip[1]]
             })
             .collect();
+    let at_max = r.configuration(chain::index_of_largest(&dy, |d| d.abs()));
     Ok(TipHistory {
         t: tr.t.clone(),
         dy,
+        at_max,
         evaluations: tr.stats.rhs_evals as u64,
         wall_time: tr.wall_time,
         dof: r.mech.n_dof(),

@@ -12,6 +12,7 @@
 
 use super::chain;
 use super::segments::{self, Built, SegmentMesh};
+use flexmb_draw::Configuration;
 use flexmb_dynamics::Integrator;
 use flexmb_element::VelocityTransform;
 use std::path::Path;
@@ -140,6 +141,9 @@ pub struct TipResponse {
     pub evaluations: u64,
     /// Wall time (s).
     pub wall_time: f64,
+    /// The configuration at the output of the largest |Δz′| (the lag in
+    /// the spin plane), to draw.
+    pub at_max: Configuration,
 }
 
 impl TipResponse {
@@ -191,7 +195,7 @@ pub fn run(
         _ => return Err("the scene needs the two joint inputs".into()),
     };
     let tr = &r.trajectory;
-    let d =
+    let d: Vec<[f64; 2]> =
         tr.t.iter()
             .zip(&tr.x)
             .map(|(t, x)| {
@@ -204,9 +208,11 @@ pub fn run(
                 [-sb * u[0] + cb * u[1], u[2]]
             })
             .collect();
+    let at_max = r.configuration(chain::index_of_largest(&d, |d| d[1].abs()));
     Ok(TipResponse {
         t: tr.t.clone(),
         d,
+        at_max,
         evaluations: tr.stats.rhs_evals as u64,
         wall_time: tr.wall_time,
     })
