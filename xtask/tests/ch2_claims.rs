@@ -127,12 +127,29 @@ fn only_b1_is_sensitive_to_reversing_the_elements() {
 /// The configuration a run keeps for its picture is the one at its largest
 /// |Δy′|, as the run reached it: Δy′ recomputed from its nodal coordinates
 /// and the spin angle at its time is the run's maximum, and the picture
-/// puts the tip there.
+/// puts the tip there; the report's picture of it is written as SVG and
+/// PNG.
 #[test]
 fn the_spin_up_picture_shows_the_largest_deflection() {
     let dir = temp_dir("picture");
     let scene = spin_up::beam_scene(4, false);
     let tip = spin_up::run(&scene, &dir, Integration::table(1e-6)).unwrap();
+    let mut figs = xtask::report::Figures::default();
+    let opts = flexmb_draw::DrawOptions {
+        view: Some(flexmb_draw::View::Xy),
+        reference: true,
+        ..Default::default()
+    };
+    xtask::pictures::save(&mut figs, &dir, "mech", &tip.at_max, &opts).unwrap();
+    for ext in ["svg", "png"] {
+        let f = dir.join(format!("mech.{ext}"));
+        assert!(
+            std::fs::metadata(&f)
+                .map(|m| m.len() > 1000)
+                .unwrap_or(false),
+            "{f:?}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
     let at = &tip.at_max;
     let mech = &at.mechanism;
