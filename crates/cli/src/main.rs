@@ -739,10 +739,16 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
     pb.finish_and_clear();
     let outcome = outcome.map_err(|e| Failure::Compute(e.to_string()))?;
     if outcome.stopped && outcome.points.is_empty() {
-        return Err(Failure::Interrupted(format!(
-            "nothing written: stopped while finding the equilibria ({} of {n} found), before any eigen analysis",
-            outcome.equilibria
-        )));
+        return Err(Failure::Interrupted(if outcome.equilibria < n {
+            format!(
+                "nothing written: stopped while finding the equilibria ({} of {n} found), before any eigen analysis",
+                outcome.equilibria
+            )
+        } else {
+            format!(
+                "nothing written: stopped in the first eigen analyses (all {n} equilibria found, no eigen analysis finished)"
+            )
+        }));
     }
     let pts = outcome.points;
     let wall = start.elapsed().as_secs_f64();

@@ -24,6 +24,7 @@
 //! [`skyline::NotPositiveDefinite`], [`EigenError`], [`CholeskyError`]); the
 //! physics crates wrap it as the source of their own errors.
 
+mod abandon;
 pub mod eigen;
 pub mod lu;
 mod shift_invert;
