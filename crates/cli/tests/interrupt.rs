@@ -493,8 +493,9 @@ fn chain_1440(dir: &Path) -> PathBuf {
 
 /// The stop latency we accept for the 1440-DOF chain, from the signal to the
 /// end of the computation as the process reports it. Its longest stretch
-/// without a check is one part of a linearization or of an eigen analysis,
-/// about 0.1 s on an idle machine; it stopped 61–194 ms after the signal on
+/// without a check is one part of a linearization (since the mass assembly
+/// and the eigen analyses read the request inside, 69 ms at load 3.4),
+/// about 0.1 s on an idle machine before; it stopped 61–194 ms after the signal on
 /// this 2-core machine loaded by two other sessions (load average 5). Before
 /// the checks inside the linearization and the eigensolver, each of the two
 /// workers had about 1.4 s of work per configuration without a check: it

@@ -339,7 +339,7 @@ impl Dynamics {
         self.kinematics_at(t, q, Some(&vec![0.0; n_q]))?;
         check()?;
         self.forces(t, false);
-        self.inertia(true);
+        self.inertia_until(stop)?;
         check()?;
         let m = self.mq.clone();
         let neg_f: Vec<f64> = self.f.iter().map(|v| -v).collect();

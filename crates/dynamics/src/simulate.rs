@@ -560,7 +560,7 @@ impl Dynamics {
         self.kinematics_at(t, q, Some(qd))?;
         check()?;
         self.forces(t, true);
-        self.inertia(true);
+        self.inertia_until(stop)?;
         check()?;
         let n_q = self.n_q();
         let mq = self.mq.clone();
