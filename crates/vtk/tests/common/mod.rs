@@ -18,12 +18,15 @@ fn python_with_meshio() -> String {
     panic!("no Python with meshio: install it (Debian: apt-get install python3-meshio; pip install meshio)");
 }
 
-/// Runs the Python `script`, which prints `ok` when its checks pass.
+/// Runs the Python `script`, which prints `ok` when its checks pass, and
+/// prints what it printed.
 pub fn check_with_python(script: &str) {
     let o = Command::new(python_with_meshio())
         .args(["-c", script])
         .output()
         .unwrap();
+    // what the script measured (`--nocapture` shows it)
+    println!("{}", String::from_utf8_lossy(&o.stdout));
     assert!(
         o.status.success() && String::from_utf8_lossy(&o.stdout).contains("ok"),
         "meshio check failed:\n{}\n{}",
