@@ -9,7 +9,7 @@
 //!   (for FE nodes: from their recovered reference positions), and whatever
 //!   the caller adds (one entry per point, [`Drawing::n_points`]).
 //! * Cells: a superelement whose file has an FE mesh (`fe_mesh`,
-//!   [`flexmb_element::FeMesh`]) is drawn as its FE cells (VTK tetra,
+//!   `flexmb_element::FeMesh`) is drawn as its FE cells (VTK tetra,
 //!   hexahedron, wedge and their quadratic forms, in VTK's node order) at
 //!   the positions that `flexmb_superelement::recovery::MeshRecovery`
 //!   places them at from the element's coordinates (r_p, λp, r_q, λq, η̄),
