@@ -76,6 +76,10 @@ enum Command {
         /// this directory.
         #[arg(long, value_name = "DIR")]
         vtk: Option<PathBuf>,
+        /// With --vtk: draw superelements as the chord between their nodes,
+        /// not as their FE mesh (smaller files for large meshes).
+        #[arg(long, requires = "vtk")]
+        vtk_chords: bool,
     },
     /// Time response from the reference configuration (or from equilibrium with --static-first).
     Simulate(SimulateArgs),
@@ -98,6 +102,10 @@ enum Command {
         /// (mode_K.pvd) as VTK to this directory.
         #[arg(long, value_name = "DIR")]
         vtk: Option<PathBuf>,
+        /// With --vtk: draw superelements as the chord between their nodes,
+        /// not as their FE mesh (smaller files for large meshes).
+        #[arg(long, requires = "vtk")]
+        vtk_chords: bool,
     },
     /// Eigenfrequencies along the range of motion: over a load scale or a
     /// held coordinate, n equilibria, eigen analyses in parallel.
@@ -150,6 +158,10 @@ struct SimulateArgs {
     /// (simulate.pvd and one VTU file per output) to this directory.
     #[arg(long, value_name = "DIR")]
     vtk: Option<PathBuf>,
+    /// With --vtk: draw superelements as the chord between their nodes,
+    /// not as their FE mesh (smaller files for large meshes).
+    #[arg(long, requires = "vtk")]
+    vtk_chords: bool,
 }
 
 /// Options of `flexmb sweep`.
@@ -199,6 +211,10 @@ struct SweepArgs {
     /// this directory.
     #[arg(long, value_name = "DIR")]
     vtk: Option<PathBuf>,
+    /// With --vtk: draw superelements as the chord between their nodes,
+    /// not as their FE mesh (smaller files for large meshes).
+    #[arg(long, requires = "vtk")]
+    vtk_chords: bool,
 }
 
 /// Why a command failed, which decides the exit code.
@@ -276,7 +292,14 @@ fn run(command: Command) -> Result<(), Failure> {
             steps,
             out,
             vtk,
-        } => statics(&scene, time, steps, &out, vtk.as_deref()),
+            vtk_chords,
+        } => statics(
+            &scene,
+            time,
+            steps,
+            &out,
+            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_chords)),
+        ),
         Command::Simulate(a) => simulate(&a),
         Command::Eig {
             scene,
@@ -284,7 +307,14 @@ fn run(command: Command) -> Result<(), Failure> {
             static_first,
             buckling,
             vtk,
-        } => eig(&scene, modes, static_first, buckling, vtk.as_deref()),
+            vtk_chords,
+        } => eig(
+            &scene,
+            modes,
+            static_first,
+            buckling,
+            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_chords)),
+        ),
         Command::Sweep(a) => sweep(&a),
         Command::Reduce(a) => reduce::reduce(&a),
         Command::Draw(a) => draw::draw(&a),
@@ -336,14 +366,14 @@ fn statics(
     t: f64,
     steps: usize,
     out: &Path,
-    vtk: Option<&Path>,
+    vtk: Option<vtk_out::VtkOut<'_>>,
 ) -> Result<(), Failure> {
     options::finite("--time", t)?;
     options::at_least("--steps", steps, 1, "the number of load increments")?;
     let (_, mech) = load(path)?;
     options::writable_dir("--out", out)?;
-    if let Some(d) = vtk {
-        options::writable_dir("--vtk", d)?;
+    if let Some(v) = vtk {
+        options::writable_dir("--vtk", v.dir)?;
     }
     let mut dy = Dynamics::new(mech.clone());
     let opts = StaticOptions {
@@ -484,7 +514,12 @@ fn simulate(a: &SimulateArgs) -> Result<(), Failure> {
             .zip(&response.x)
             .map(|(t, x)| (*t, x.as_slice()))
             .collect();
-        vtk_out::write(d, "simulate", &mech, &frames)?;
+        vtk_out::write(
+            vtk_out::VtkOut::new(d, a.vtk_chords),
+            "simulate",
+            &mech,
+            &frames,
+        )?;
     }
     match partial {
         Some(p) => Err(Failure::Interrupted(format!(
@@ -580,14 +615,14 @@ fn eig(
     modes: Option<usize>,
     static_first: bool,
     buckling: bool,
-    vtk: Option<&Path>,
+    vtk: Option<vtk_out::VtkOut<'_>>,
 ) -> Result<(), Failure> {
     if let Some(k) = modes {
         options::at_least("--modes", k, 1, "the number of modes")?;
     }
     let (_, mech) = load(path)?;
-    if let Some(d) = vtk {
-        options::writable_dir("--vtk", d)?;
+    if let Some(v) = vtk {
+        options::writable_dir("--vtk", v.dir)?;
     }
     let k = options::modes_or_default(modes, 10, &mech)?;
     let mut dy = Dynamics::new(mech.clone());
@@ -777,7 +812,7 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
     }
     write_frequency_sweep(&sw, &comments, &a.out)?;
     if let Some(d) = &a.vtk {
-        vtk_out::write_sweep_points(d, &mech, a.t_load, &pts)?;
+        vtk_out::write_sweep_points(vtk_out::VtkOut::new(d, a.vtk_chords), &mech, a.t_load, &pts)?;
     }
     if outcome.stopped {
         return Err(Failure::Interrupted(format!(

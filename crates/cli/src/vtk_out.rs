@@ -7,7 +7,35 @@ use crate::Failure;
 use faer::Mat;
 use flexmb_dynamics::Dynamics;
 use flexmb_model::Mechanism;
+use flexmb_vtk::{Drawing, Superelements};
 use std::path::Path;
+
+/// Where `--vtk` writes and how it draws superelements (`--vtk-chords`).
+#[derive(Clone, Copy)]
+pub(crate) struct VtkOut<'a> {
+    /// The directory.
+    pub dir: &'a Path,
+    /// Superelements as their FE mesh or as chords.
+    pub style: Superelements,
+}
+
+impl<'a> VtkOut<'a> {
+    /// `--vtk DIR` with `--vtk-chords` if `chords`.
+    pub(crate) fn new(dir: &'a Path, chords: bool) -> Self {
+        Self {
+            dir,
+            style: if chords {
+                Superelements::Chord
+            } else {
+                Superelements::Mesh
+            },
+        }
+    }
+
+    fn drawing<'m>(&self, mech: &'m Mechanism) -> Result<Drawing<'m>, Failure> {
+        Drawing::new(mech, self.style).map_err(vtk_err)
+    }
+}
 
 /// Named point data: one 3-vector per node.
 type PointData = Vec<(String, Vec<[f64; 3]>)>;
@@ -23,17 +51,18 @@ fn vtk_err(e: flexmb_vtk::VtkError) -> Failure {
 /// Writes `frames` (time, nodal coordinates x) of `mech` as `dir/NAME_….vtu`
 /// and `dir/NAME.pvd`.
 pub(crate) fn write(
-    dir: &Path,
+    out: VtkOut<'_>,
     name: &str,
     mech: &Mechanism,
     frames: &[(f64, &[f64])],
 ) -> Result<(), Failure> {
+    let mut drawing = out.drawing(mech)?;
     let texts = frames
         .iter()
-        .map(|(t, x)| flexmb_vtk::configuration(mech, x, &[]).map(|s| (*t, s)))
+        .map(|(t, x)| drawing.configuration(x, &[], &[]).map(|s| (*t, s)))
         .collect::<Result<Vec<_>, _>>()
         .map_err(vtk_err)?;
-    write_texts(dir, name, &texts)
+    write_texts(out.dir, name, &texts)
 }
 
 /// Writes VTU texts as a series and says so.
@@ -51,7 +80,7 @@ fn write_texts(dir: &Path, name: &str, texts: &[(f64, String)]) -> Result<(), Fa
 fn write_with_data(
     dir: &Path,
     name: &str,
-    mech: &Mechanism,
+    drawing: &mut Drawing<'_>,
     frames: &Frames,
 ) -> Result<(), Failure> {
     let texts = frames
@@ -59,7 +88,7 @@ fn write_with_data(
         .map(|(t, x, data)| {
             let data: Vec<(&str, Vec<[f64; 3]>)> =
                 data.iter().map(|(n, v)| (n.as_str(), v.clone())).collect();
-            flexmb_vtk::configuration(mech, x, &data).map(|s| (*t, s))
+            drawing.configuration(x, &data, &[]).map(|s| (*t, s))
         })
         .collect::<Result<Vec<_>, _>>()
         .map_err(vtk_err)?;
@@ -120,17 +149,26 @@ fn signed_mode(shapes: &Mat<f64>, j: usize) -> Vec<f64> {
     }
 }
 
-/// The node displacements of each mode in `shapes`, as point data `mode_1`,
-/// `mode_2`, …, each scaled to the largest node displacement `size`.
-fn mode_fields(mech: &Mechanism, shapes: &Mat<f64>, size: f64) -> Result<PointData, Failure> {
+/// The point displacements of each mode in `shapes` at `x`, as point data
+/// `mode_1`, `mode_2`, …, each scaled to the largest node displacement
+/// `size` (FE nodes of superelement meshes: recovered at that amplitude,
+/// [`Drawing::displacements`]).
+fn mode_fields(
+    drawing: &mut Drawing<'_>,
+    mech: &Mechanism,
+    x: &[f64],
+    shapes: &Mat<f64>,
+    size: f64,
+) -> Result<PointData, Failure> {
     (0..shapes.ncols())
         .map(|j| {
-            let d = flexmb_vtk::node_vectors(mech, &signed_mode(shapes, j)).map_err(vtk_err)?;
+            let v = signed_mode(shapes, j);
+            let d = flexmb_vtk::node_vectors(mech, &v).map_err(vtk_err)?;
             let max = flexmb_vtk::largest_length(&d);
             let a = if max > 0.0 { size / max } else { 0.0 };
             Ok((
                 format!("mode_{}", j + 1),
-                d.iter().map(|p| p.map(|c| a * c)).collect(),
+                drawing.displacements(x, &v, a).map_err(vtk_err)?,
             ))
         })
         .collect()
@@ -144,7 +182,7 @@ const MODE_FRAMES: usize = 24;
 /// one period (`mode_K.pvd`, point data `mode_shape`, field data
 /// `frequency_hz`).
 pub(crate) fn write_eig(
-    dir: &Path,
+    out: VtkOut<'_>,
     mech: &Mechanism,
     t: f64,
     x: &[f64],
@@ -152,20 +190,21 @@ pub(crate) fn write_eig(
     frequencies_hz: &[f64],
 ) -> Result<(), Failure> {
     let size = mode_size(mech);
-    let fields = mode_fields(mech, shapes, size)?;
-    write_with_data(dir, "eig", mech, &[(t, x.to_vec(), fields)])?;
+    let mut drawing = out.drawing(mech)?;
+    let fields = mode_fields(&mut drawing, mech, x, shapes, size)?;
+    write_with_data(out.dir, "eig", &mut drawing, &[(t, x.to_vec(), fields)])?;
     for (j, f) in frequencies_hz.iter().enumerate() {
         let name = format!("mode_{}", j + 1);
-        let texts = flexmb_vtk::mode_frames(
-            mech,
-            x,
-            &signed_mode(shapes, j),
-            size,
-            MODE_FRAMES,
-            &[("frequency_hz", *f)],
-        )
-        .map_err(vtk_err)?;
-        write_texts(dir, &name, &texts)?;
+        let texts = drawing
+            .mode_frames(
+                x,
+                &signed_mode(shapes, j),
+                size,
+                MODE_FRAMES,
+                &[("frequency_hz", *f)],
+            )
+            .map_err(vtk_err)?;
+        write_texts(out.dir, &name, &texts)?;
     }
     Ok(())
 }
@@ -174,23 +213,30 @@ pub(crate) fn write_eig(
 /// modes in nodal coordinates) as one series `sweep.pvd` with the
 /// parameter as the time value and the modes as point data `mode_1`, ….
 pub(crate) fn write_sweep(
-    dir: &Path,
+    out: VtkOut<'_>,
     mech: &Mechanism,
     points: &[(f64, Vec<f64>, Mat<f64>)],
 ) -> Result<(), Failure> {
     let size = mode_size(mech);
+    let mut drawing = out.drawing(mech)?;
     let frames = points
         .iter()
-        .map(|(s, x, shapes)| Ok((*s, x.clone(), mode_fields(mech, shapes, size)?)))
+        .map(|(s, x, shapes)| {
+            Ok((
+                *s,
+                x.clone(),
+                mode_fields(&mut drawing, mech, x, shapes, size)?,
+            ))
+        })
         .collect::<Result<Vec<_>, Failure>>()?;
-    write_with_data(dir, "sweep", mech, &frames)
+    write_with_data(out.dir, "sweep", &mut drawing, &frames)
 }
 
 /// `sweep --vtk` of the unreduced model: [`write_sweep`] of the points of
 /// `flexmb_linearize::sweep_until` (modes kept), each configuration solved
 /// from the previous one's (loads and inputs at `t`).
 pub(crate) fn write_sweep_points(
-    dir: &Path,
+    out: VtkOut<'_>,
     mech: &std::sync::Arc<Mechanism>,
     t: f64,
     points: &[flexmb_linearize::SweepPoint],
@@ -206,7 +252,7 @@ pub(crate) fn write_sweep_points(
             Ok((p.s, x, shapes))
         })
         .collect::<Result<Vec<_>, Failure>>()?;
-    write_sweep(dir, mech, &frames)
+    write_sweep(out, mech, &frames)
 }
 
 /// `sweep --reduced --vtk`: at each reduced equilibrium (load scale λ, z,
@@ -215,7 +261,7 @@ pub(crate) fn write_sweep_points(
 /// ([`MechanicalModel::full_state`](flexmb_reduction::MechanicalModel::full_state))
 /// and to nodal coordinates by F,q; then [`write_sweep`].
 pub(crate) fn write_reduced_sweep(
-    dir: &Path,
+    out: VtkOut<'_>,
     model: &mut dyn flexmb_reduction::MechanicalModel,
     t: f64,
     count: usize,
@@ -247,5 +293,5 @@ pub(crate) fn write_reduced_sweep(
         let (x, shapes) = nodal_modes(dy, t, &q, &vq)?;
         frames.push((p.load_scale, x, shapes));
     }
-    write_sweep(dir, model.mechanism(), &frames)
+    write_sweep(out, model.mechanism(), &frames)
 }

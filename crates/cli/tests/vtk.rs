@@ -1,9 +1,11 @@
 //! `--vtk DIR` on `static` and `simulate`: a PVD collection with one VTU
-//! file per configuration, the configuration the command computed, and an
-//! unwritable directory refused before any computation.
+//! file per configuration, the configuration the command computed, an
+//! unwritable directory refused before any computation, and a superelement
+//! drawn as its FE mesh (or, with `--vtk-chords`, as its chord) by `eig`
+//! and `static`.
 
 mod common;
-use common::{fixture, flexmb, temp_dir};
+use common::{fixture, flexmb, meshio_check, temp_dir};
 
 /// The `NumberOfPoints` and the first point of a VTU text.
 fn points(vtu: &str) -> (usize, [f64; 3]) {
@@ -81,5 +83,99 @@ fn an_unwritable_vtk_directory_is_refused_first() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("--vtk"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A 200 mm steel bar superelement (4 × 1 × 1 twenty-node hexahedra, two
+/// normal modes) written to `dir/bar.se.ron`, and a scene `dir/bar.ron`
+/// with it clamped at P and loaded at Q; returns its FE node count.
+fn bar_scene(dir: &std::path::Path) -> usize {
+    let steel = flexmb_element::Material {
+        e: 2.1e11,
+        g: 8.0e10,
+        rho: 7800.0,
+    };
+    let part =
+        flexmb_superelement::parts::prismatic_bar(0.2, 0.01, 0.01, [4, 1, 1], steel).unwrap();
+    let model = part.mesh.assemble("bar").unwrap();
+    let mut s = part.settings.clone();
+    s.normal_modes = 2;
+    let data = flexmb_superelement::build(&model, &s).unwrap().data;
+    flexmb_superelement::spec::write_ron(&dir.join("bar.se.ron"), &data).unwrap();
+    std::fs::write(
+        dir.join("bar.ron"),
+        r#"(
+    dimension: Spatial,
+    nodes: [ (id: "P", at: [0.0, 0.0, 0.0]), (id: "Q", at: [0.2, 0.0, 0.0]) ],
+    elements: [ (id: "bar", type: Superelement(nodes: ("P", "Q"), file: "bar.se.ron")) ],
+    fixed: [ Node("P") ],
+    loads: [ (node: "Q", force: Some([0.0, 30.0, -20.0])) ],
+)"#,
+    )
+    .unwrap();
+    model.n_nodes()
+}
+
+#[test]
+fn a_superelement_is_drawn_as_its_mesh_or_with_vtk_chords_as_its_chord() {
+    let dir = temp_dir("vtk", "superelement");
+    let n_fe = bar_scene(&dir);
+    let run = |args: &[&str]| {
+        let o = flexmb()
+            .args(args)
+            .arg(dir.join("bar.ron"))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    run(&[
+        "static",
+        "--out",
+        out,
+        "--vtk",
+        dir.join("mesh").to_str().unwrap(),
+    ]);
+    run(&[
+        "static",
+        "--out",
+        out,
+        "--vtk-chords",
+        "--vtk",
+        dir.join("chord").to_str().unwrap(),
+    ]);
+    run(&[
+        "eig",
+        "--modes",
+        "2",
+        "--vtk",
+        dir.join("eig").to_str().unwrap(),
+    ]);
+    meshio_check(&format!(
+        r#"
+import meshio, numpy as np
+d = "{d}"
+m = meshio.read(d + "/mesh/static_0000.vtu")
+assert m.points.shape == ({n} + 2, 3), m.points.shape
+assert [b.type for b in m.cells] == ["hexahedron20"] and len(m.cells[0].data) == 4, m.cells
+# the load bends the bar: the FE nodes at q move with Q
+disp = m.point_data["displacement"]
+assert np.linalg.norm(disp[2:], axis=1).max() > 1e-4, disp
+c = meshio.read(d + "/chord/static_0000.vtu")
+assert c.points.shape == (2, 3) and [b.type for b in c.cells] == ["line"], c.cells
+assert np.abs(c.points - m.points[:2]).max() == 0
+e = meshio.read(d + "/eig/eig_0000.vtu")
+for k in (1, 2):
+    f = e.point_data["mode_%d" % k]
+    assert f.shape == ({n} + 2, 3) and np.linalg.norm(f[2:], axis=1).max() > 0, f
+    s = meshio.read(d + "/eig/mode_%d_0006.vtu" % k)
+    assert s.points.shape == ({n} + 2, 3)
+    assert np.abs(s.point_data["displacement"] - s.point_data["mode_shape"]).max() < 1e-12
+print("ok")
+"#,
+        d = dir.display(),
+        n = n_fe
+    ));
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -1597,6 +1597,18 @@ impl Element {
         }
     }
 
+    /// The local coordinates `x` as the element measures them, into `out`
+    /// (same length): each slot with an initial orientation λ0
+    /// ([`with_initial_orientation`](Self::with_initial_orientation)) holds
+    /// λ ∘ λ0* (planar φ − φ0), the rotation since the start; the other
+    /// entries are copied. What a superelement's mesh recovery takes.
+    pub fn measured_coordinates(&self, x: &[f64], out: &mut [f64]) {
+        match &self.initial {
+            None => out.copy_from_slice(x),
+            Some(f) => out.copy_from_slice(&f.point(x)),
+        }
+    }
+
     /// ε = D(x). `prev` (the previous deformations) keeps hinge angles continuous
     /// over many turns; pass `None` for the principal value.
     pub fn deformations(&self, x: &[f64], prev: Option<&[f64]>, eps: &mut [f64]) {

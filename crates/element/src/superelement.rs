@@ -227,9 +227,26 @@ impl LinearSuperelement {
     }
 }
 
+impl FeCell {
+    /// The number of nodes of a cell of VTK type `vtk_type`, for the types
+    /// a mesh may hold (see [`FeCell`]); `None` for other types.
+    pub fn node_count(vtk_type: u8) -> Option<usize> {
+        match vtk_type {
+            10 => Some(4),
+            24 => Some(10),
+            12 => Some(8),
+            25 => Some(20),
+            13 => Some(6),
+            26 => Some(15),
+            _ => None,
+        }
+    }
+}
+
 impl FeMesh {
     /// Checks the sizes against `n_coords` = 6 + k coordinates, the cells'
-    /// node indices and finiteness. Errors name the node or cell.
+    /// types, node counts and node indices, and finiteness. Errors name the
+    /// node or cell.
     pub fn validate(&self, n_coords: usize) -> Result<(), ElementError> {
         let bad = |m: String| Err(ElementError::Superelement(format!("fe_mesh: {m}")));
         let n = self.nodes.len();
@@ -253,6 +270,22 @@ impl FeMesh {
             }
         }
         for (c, cell) in self.cells.iter().enumerate() {
+            match FeCell::node_count(cell.vtk_type) {
+                None => {
+                    return bad(format!(
+                        "cell {c} has VTK type {}, not one of 10, 24, 12, 25, 13, 26 (tetra, quadratic tetra, hexahedron, quadratic hexahedron, wedge, quadratic wedge)",
+                        cell.vtk_type
+                    ))
+                }
+                Some(k) if k != cell.nodes.len() => {
+                    return bad(format!(
+                        "cell {c} (VTK type {}) has {} nodes, the type has {k}",
+                        cell.vtk_type,
+                        cell.nodes.len()
+                    ))
+                }
+                Some(_) => {}
+            }
             if let Some(&j) = cell.nodes.iter().find(|&&j| j >= n) {
                 return bad(format!(
                     "cell {c} refers to node {j}, but there are {n} nodes"

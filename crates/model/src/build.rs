@@ -7,7 +7,8 @@ use flexmb_element::{BeamOptions, Element, LinearSuperelement, Material, Section
 use flexmb_rotation::EulerParameters;
 use nalgebra::Vector3;
 use std::collections::{BTreeMap, HashMap};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 mod chains;
 mod checks;
@@ -239,6 +240,9 @@ pub fn build_reporting(
     let mut element_ids = HashMap::new();
     let mut mode_groups: Vec<(String, usize)> = vec![];
     let mut part_axes: HashMap<String, PartAxis> = HashMap::new();
+    // superelement data by element id, and each file read once
+    let mut part_data: HashMap<String, Arc<LinearSuperelement>> = HashMap::new();
+    let mut files: HashMap<PathBuf, Arc<LinearSuperelement>> = HashMap::new();
     let mut chain_total = 0usize;
     for entry in &scene.elements {
         let id = entry.id.clone();
@@ -503,12 +507,19 @@ pub fn build_reporting(
                     Some(d) => d.join(file),
                     None => Path::new(file).to_path_buf(),
                 };
-                let text = std::fs::read_to_string(&path).map_err(|e| ModelError::Io {
-                    path: path.display().to_string(),
-                    message: e.to_string(),
-                })?;
-                let data: LinearSuperelement =
-                    crate::parse_ron(&text, &path.display().to_string())?;
+                let data = match files.get(&path) {
+                    Some(d) => d.clone(),
+                    None => {
+                        let text = std::fs::read_to_string(&path).map_err(|e| ModelError::Io {
+                            path: path.display().to_string(),
+                            message: e.to_string(),
+                        })?;
+                        let d: Arc<LinearSuperelement> =
+                            Arc::new(crate::parse_ron(&text, &path.display().to_string())?);
+                        files.insert(path.clone(), d.clone());
+                        d
+                    }
+                };
                 let l =
                     ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt();
                 if (l - data.l0).abs() > 1e-9 * data.l0.max(1e-12) {
@@ -530,6 +541,7 @@ pub fn build_reporting(
                         x: std::array::from_fn(|i| data.r0[i][0]),
                     },
                 );
+                part_data.insert(id.clone(), data.clone());
                 let (kp, kq, kf) = data.mode_counts();
                 let gp = share.0.clone().unwrap_or_else(|| format!("{id}.p"));
                 let gq = share.1.clone().unwrap_or_else(|| format!("{id}.q"));
@@ -746,6 +758,7 @@ pub fn build_reporting(
             eps_names.push(format!("{}.{n}", e.id));
         }
         elements.push(MechElement {
+            superelement: part_data.remove(&e.id),
             id: e.id,
             group: e.group,
             element: e.element,
@@ -765,6 +778,7 @@ pub fn build_reporting(
                     element,
                     x_index: o.clone(),
                     eps_offset,
+                    superelement: None,
                 });
             }
         }

@@ -3,7 +3,8 @@
 
 use crate::scene::{Dimension, OutputSpec};
 use crate::TimeFunction;
-use flexmb_element::Element;
+use flexmb_element::{Element, LinearSuperelement};
+use std::sync::Arc;
 
 /// Role of a nodal coordinate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -53,6 +54,14 @@ pub struct MechElement {
     pub x_index: Vec<usize>,
     /// Index of its first deformation in the global deformation vector.
     pub eps_offset: usize,
+    /// A superelement's data as read from its file (shared between the
+    /// elements that use the same file): S̄, M̄, R0 and, if the builder wrote
+    /// it, the FE mesh with its recovery (`flexmb_superelement::recovery`
+    /// places it; the VTK writer draws it). For a superelement, `x_index`
+    /// gathers exactly the coordinates that recovery takes: (r_p, λp, r_q,
+    /// λq, η̄) with η̄ its p, q and normal mode groups in turn. `None` for
+    /// the other elements.
+    pub superelement: Option<Arc<LinearSuperelement>>,
 }
 
 impl MechElement {

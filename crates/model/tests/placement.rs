@@ -135,3 +135,51 @@ fn every_fixture_scene_passes_the_reference_check() {
     }
     assert!(n >= 9, "{n} fixture scenes");
 }
+
+/// The built mechanism keeps each superelement's data, read once per file:
+/// two elements from one file share it, and `x_index` gathers the
+/// coordinates (r_p, λp, r_q, λq, η̄) in that order.
+#[test]
+fn superelements_from_one_file_share_their_data() {
+    let dir = temp("shared");
+    let data = bar_superelement(&dir);
+    let mech = Scene::from_ron_str(&format!(
+        r#"(
+    nodes: [ (id: "P", at: [0.0, 0.0, 0.0]), (id: "Q", at: [{L}, 0.0, 0.0]), (id: "R", at: [{}, 0.0, 0.0]) ],
+    elements: [
+        (id: "a", type: Superelement(nodes: ("P", "Q"), file: "bar.se.ron")),
+        (id: "b", type: Superelement(nodes: ("Q", "R"), file: "bar.se.ron")),
+    ],
+    fixed: [ Node("P") ],
+)"#,
+        2.0 * L
+    ))
+    .unwrap()
+    .build(Some(&dir))
+    .unwrap();
+    let a = mech.element_by_id("a").unwrap();
+    let b = mech.element_by_id("b").unwrap();
+    let (da, db) = (
+        a.superelement.clone().unwrap(),
+        b.superelement.clone().unwrap(),
+    );
+    assert!(std::sync::Arc::ptr_eq(&da, &db), "read twice");
+    assert_eq!(*da, data);
+    let mut want = vec![];
+    for id in ["Q", "R"] {
+        let n = mech.node(id).unwrap();
+        want.extend(&n.position);
+        want.extend(n.orientation.as_ref().unwrap());
+    }
+    for g in ["b.p", "b.q", "b.f"] {
+        want.extend(&mech.mode_groups.iter().find(|(n, _)| n == g).unwrap().1);
+    }
+    assert_eq!(b.x_index, want);
+    // the node normalizations are no superelements
+    assert!(mech
+        .elements
+        .iter()
+        .filter(|e| e.element.is_normalization())
+        .all(|e| e.superelement.is_none()));
+    std::fs::remove_dir_all(&dir).ok();
+}

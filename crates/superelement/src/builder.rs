@@ -1258,7 +1258,11 @@ fn fe_mesh(
             .zip(&sol.nodes)
             .map(|(k, n)| FeCell {
                 vtk_type: k.vtk_type(),
-                nodes: n.clone(),
+                nodes: k
+                    .vtk_order()
+                    .iter()
+                    .filter_map(|&i| n.get(i).copied())
+                    .collect(),
             })
             .collect()
     });

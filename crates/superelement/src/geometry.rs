@@ -61,8 +61,8 @@ impl SolidKind {
         }
     }
 
-    /// The VTK cell type with the same node order (the Abaqus/CalculiX order of
-    /// corners, then edge midsides, is VTK's for these kinds).
+    /// The VTK cell type of this kind; its nodes in VTK's order are
+    /// [`vtk_order`](Self::vtk_order).
     pub fn vtk_type(self) -> u8 {
         match self {
             SolidKind::Tet4 => 10,
@@ -71,6 +71,33 @@ impl SolidKind {
             SolidKind::Hex20 => 25,
             SolidKind::Wedge6 => 13,
             SolidKind::Wedge15 => 26,
+        }
+    }
+}
+
+/// Abaqus C3D6 → VTK_WEDGE: VTK's base triangle (0, 1, 2) turns the other
+/// way (its right-hand normal points away from the top face (3, 4, 5),
+/// vtkWedge's documentation and face table), Abaqus's 1-2-3 towards it.
+const WEDGE6_TO_VTK: [usize; 6] = [0, 2, 1, 3, 5, 4];
+/// Abaqus C3D15 → VTK_QUADRATIC_WEDGE: the corners turned as for the
+/// wedge, then VTK's midsides on its edges (0,1), (1,2), (2,0), (3,4),
+/// (4,5), (5,3), (0,3), (1,4), (2,5).
+const WEDGE15_TO_VTK: [usize; 15] = [0, 2, 1, 3, 5, 4, 8, 7, 6, 11, 10, 9, 12, 14, 13];
+const IDENTITY: [usize; 20] = [
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19,
+];
+
+impl SolidKind {
+    /// The node order of the VTK cell ([`vtk_type`](Self::vtk_type)): VTK
+    /// node i is node `vtk_order()[i]` of the Abaqus/CalculiX order. The
+    /// tetrahedra and hexahedra have the same order in both (corners, then
+    /// the edge midsides in the same edge order); the wedges do not: VTK's
+    /// base triangle turns the other way.
+    pub fn vtk_order(self) -> &'static [usize] {
+        match self {
+            SolidKind::Wedge6 => &WEDGE6_TO_VTK,
+            SolidKind::Wedge15 => &WEDGE15_TO_VTK,
+            k => &IDENTITY[..k.n_nodes()],
         }
     }
 }

@@ -275,3 +275,22 @@ fn files_with_and_without_the_mesh_section() {
     let e = MeshRecovery::new(&old).err().unwrap().to_string();
     assert!(e.contains("fe_mesh"), "{e}");
 }
+
+/// A mesh section with a cell of an unknown VTK type, or with the wrong
+/// number of nodes for its type, is refused naming the cell.
+#[test]
+fn a_mesh_cell_of_another_type_or_size_is_refused_naming_it() {
+    let (_, _, se) = bar();
+    let mut data = se.data.clone();
+    data.validate().unwrap();
+    data.fe_mesh.as_mut().unwrap().cells[0].vtk_type = 99;
+    let e = data.validate().unwrap_err().to_string();
+    assert!(e.contains("cell 0 has VTK type 99"), "{e}");
+    let mut data = se.data.clone();
+    data.fe_mesh.as_mut().unwrap().cells[3].nodes.pop();
+    let e = data.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("cell 3 (VTK type 25) has 19 nodes, the type has 20"),
+        "{e}"
+    );
+}

@@ -2,23 +2,9 @@
 //! `.ci/run` installs the Debian package python3-meshio): coordinates,
 //! connectivity and fields.
 
-use flexmb_model::Scene;
-use std::process::Command;
+mod common;
 
-/// A Python with meshio: `python3`, or the system's `/usr/bin/python3`
-/// where `python3` is another installation.
-fn python_with_meshio() -> String {
-    for p in ["python3", "/usr/bin/python3"] {
-        let ok = Command::new(p)
-            .args(["-c", "import meshio"])
-            .output()
-            .is_ok_and(|o| o.status.success());
-        if ok {
-            return p.to_string();
-        }
-    }
-    panic!("no Python with meshio: install it (Debian: apt-get install python3-meshio; pip install meshio)");
-}
+use flexmb_model::Scene;
 
 const SCENE: &str = r#"(
     dimension: Spatial,
@@ -102,16 +88,7 @@ print("ok")
 "#,
         d = dir.display()
     );
-    let o = Command::new(python_with_meshio())
-        .args(["-c", &check])
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success() && String::from_utf8_lossy(&o.stdout).contains("ok"),
-        "meshio check failed:\n{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
+    common::check_with_python(&check);
     std::fs::remove_dir_all(&dir).ok();
 }
 
