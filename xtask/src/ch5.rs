@@ -481,6 +481,7 @@ fn write(
     figs.save(
         &speed_vs_error_plot(
             "Chapter 5 guidance: speed against error",
+            "largest relative error (eigenfrequencies, time response)",
             &guidance_rows[1..],
         ),
         out,

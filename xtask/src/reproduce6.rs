@@ -371,7 +371,11 @@ fn write_outputs(
         });
     }
     figs.save(
-        &speed_vs_error_plot("Chapter 6: speed against error", &rows_out[1..]),
+        &speed_vs_error_plot(
+            "Chapter 6: speed against error",
+            "largest relative error (eigenfrequencies, time response)",
+            &rows_out[1..],
+        ),
         out,
         "speed_vs_error",
     )?;

@@ -146,14 +146,27 @@ fn read_state(mech: &Arc<Mechanism>, file: &Path) -> Result<Vec<f64>, Failure> {
         dofs_read += 1;
     }
     if dofs_read == 0 {
-        return Err(bad(if passed_over.is_empty() {
-            "no degree-of-freedom column (`flexmb info SCENE` lists them)".to_string()
-        } else {
-            format!(
-                "no degree-of-freedom column, only the scene's outputs {passed_over:?}, which do not \
-                 fix a configuration: add `Dofs` to the scene's `outputs` and run `simulate` again"
-            )
-        }));
+        if passed_over.is_empty() {
+            return Err(bad(
+                "no degree-of-freedom column (`flexmb info SCENE` lists them)".into(),
+            ));
+        }
+        // an output column that is a coordinate of the scene (`S.x`): also
+        // say how to make it a degree of freedom
+        let as_dof = passed_over
+            .iter()
+            .find(|name| matches!(coords::selection(mech, name), Ok(Some(_))))
+            .and_then(|name| coords::dof_index(mech, name, "").err())
+            .map(|e| match e {
+                Failure::Input(m) | Failure::Compute(m) | Failure::Interrupted(m) => {
+                    format!(";{m}")
+                }
+            })
+            .unwrap_or_default();
+        return Err(bad(format!(
+            "no degree-of-freedom column, only the scene's outputs {passed_over:?}, which do not \
+             fix a configuration: add `Dofs` to the scene's `outputs` and run `simulate` again{as_dof}"
+        )));
     }
     Ok(q)
 }

@@ -479,6 +479,7 @@ pub fn write_report(
     figs.save(
         &speed_vs_error_plot(
             "Spin-up beam: wall time against the error of the maximum deflection",
+            "relative error of the maximum tip deflection",
             &rows,
         ),
         out,
