@@ -1,7 +1,9 @@
 //! The spatial beam with Vlasov warping (`warping:` in a beam's spec) against
 //! closed forms and the stored solid (research/sheet22): a clamped-free sheet
-//! at rest converges to the Vlasov torsion frequency, and bad warping input
-//! names the element.
+//! at rest converges to the Vlasov torsion frequency; deflected, its
+//! out-of-plane modes follow the clamped solid; and the chapter-6 spatial
+//! guidance, warping restrained at the base clamps and at the body, is within
+//! 2 % of the solid's f2 and f3 along the stroke (issue 22).
 
 use flexmb_element::rectangle_torsion_constant;
 use flexmb_linearize::*;
@@ -105,17 +107,12 @@ fn vlasov_torsion_hz(b: f64, t: f64) -> f64 {
         nalgebra::Matrix4::from_fn(|i, j| m[i][j]).determinant()
     };
     let st_venant = (gj / ip).sqrt() * PI / (2.0 * L);
-    let (mut lo, mut hi) = (0.9 * st_venant, 0.9 * st_venant);
-    loop {
-        let next = hi * 1.001;
-        if det(hi).signum() != det(next).signum() {
-            lo = hi;
-            hi = next;
-            break;
-        }
-        hi = next;
-        assert!(hi < 2.0 * st_venant, "no root below twice St-Venant");
+    let mut lo = 0.9 * st_venant;
+    while det(lo).signum() == det(lo * 1.001).signum() {
+        lo *= 1.001;
+        assert!(lo < 2.0 * st_venant, "no root below twice St-Venant");
     }
+    let mut hi = lo * 1.001;
     for _ in 0..100 {
         let mid = 0.5 * (lo + hi);
         if det(lo).signum() == det(mid).signum() {
@@ -150,5 +147,176 @@ fn clamped_sheet_at_rest_converges_to_the_vlasov_torsion_frequency() {
         assert!(st_venant < exact * 0.99, "{st_venant} against {exact}");
         assert!(errors[3] < 1e-3, "n = 40: {:.4} % off", 100.0 * errors[3]);
         assert!(errors[3] < errors[0], "{errors:?}");
+    }
+}
+
+/// Rows (P or x, mode, f) of a stored solid CSV of research/sheet22/results
+/// whose `kind` column (if any) is `want`.
+fn solid_rows(file: &str, key: usize, want: Option<&str>) -> Vec<(f64, f64)> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../research/sheet22/results")
+        .join(file);
+    std::fs::read_to_string(&path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            let kind_ok = want.is_none_or(|w| c.last() == Some(&w));
+            let f_at = if want.is_some() {
+                c.len() - 2
+            } else {
+                c.len() - 1
+            };
+            kind_ok.then(|| (c[key].parse().unwrap(), c[f_at].parse().unwrap()))
+        })
+        .collect()
+}
+
+/// The first two out-of-plane frequencies of the stored clamped solid at
+/// tip load `p` (b = 30 mm, t = 1 mm, 50 × 8 × 2, 10 increments).
+fn solid_o1_o2(p: f64) -> [f64; 2] {
+    let rows: Vec<f64> = solid_rows("solid_t0.001_nu0_50x8x2_incs10.csv", 5, Some("out"))
+        .into_iter()
+        .filter(|(pp, _)| (pp - p).abs() < 1e-9 * p.max(1.0))
+        .map(|(_, f)| f)
+        .collect();
+    [rows[0], rows[1]]
+}
+
+#[test]
+fn deflected_clamped_sheet_with_warping_follows_the_solid() {
+    let (b, t, n): (f64, f64, usize) = (0.03, 0.001, 20);
+    let ei = E * b * t.powi(3) / 12.0;
+    for alpha in [0.5, 1.0, 1.5] {
+        let p = alpha * ei / (L * L);
+        let solid = solid_o1_o2(p);
+        let planar = frequencies(&sheet(b, t, n, p, None, true), 10, 10);
+        let gaps = |warping: Option<&str>| {
+            let f = frequencies(&sheet(b, t, n, p, warping, false), 16, 10);
+            let o = out_of_plane(&f, &planar);
+            [o[0] / solid[0] - 1.0, o[1] / solid[1] - 1.0]
+        };
+        let plain = gaps(None);
+        let warped = gaps(Some(CLAMPED_TIP_FREE));
+        eprintln!(
+            "alpha = {alpha}: solid o1 {:.3}, o2 {:.3} Hz; beam − solid: St-Venant {:+.2} %, {:+.2} %; warping {:+.2} %, {:+.2} %",
+            solid[0],
+            solid[1],
+            100.0 * plain[0],
+            100.0 * plain[1],
+            100.0 * warped[0],
+            100.0 * warped[1]
+        );
+        // the thesis's beam is 4–11 % below the solid here; the warp-free
+        // solid (the beam's clamp) left 0.2–1.4 % (research/sheet22/README.md)
+        for k in 0..2 {
+            assert!(
+                warped[k].abs() < 0.01 && plain[k] < -0.04,
+                "alpha {alpha}, o{}: warping {warped:?}, St-Venant {plain:?}",
+                k + 1
+            );
+        }
+    }
+}
+
+/// The chapter-6 spatial guidance with `n` beams per flexure, the flexures'
+/// warping restrained at the base clamps and at the body if `warping`, S.x
+/// made the first degree of freedom (as `flexmb sweep --over S.x` does).
+fn guidance(n: usize, warping: bool) -> Arc<flexmb_model::Mechanism> {
+    use flexmb_model::{Component, ElementSpec, Select, WarpingEnd, WarpingSpec};
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fixtures/scenes/straight_guidance_spatial.ron");
+    let mut s = Scene::load(&p).unwrap();
+    for e in &mut s.elements {
+        if let ElementSpec::Beam(b) = &mut e.kind {
+            if e.id.starts_with("flexure") {
+                b.n = n;
+                b.warping = warping.then_some(WarpingSpec {
+                    p: WarpingEnd::Restrained,
+                    q: WarpingEnd::Restrained,
+                });
+            }
+        }
+    }
+    s.dofs_first
+        .insert(0, Select::Coord("S".into(), Component::X));
+    Arc::new(s.build(None).unwrap())
+}
+
+/// f1 … f`k` along the stroke: one continuation in S.x through `xs`.
+fn guidance_sweep(mech: &Arc<flexmb_model::Mechanism>, xs: &[f64], k: usize) -> Vec<Vec<f64>> {
+    let x0 = mech.q0()[0];
+    let param = SweepParameter::Path {
+        dofs: vec![0],
+        path: Box::new(move |s| vec![x0 + s]),
+    };
+    let opts = SweepOptions {
+        values: xs.to_vec(),
+        modes: k,
+        t: 0.0,
+        keep_vectors: false,
+    };
+    sweep(mech, &param, &opts, &|_, _| {})
+        .unwrap()
+        .into_iter()
+        .map(|p| p.frequencies_hz)
+        .collect()
+}
+
+#[test]
+fn guidance_with_warping_restrained_at_clamps_and_body_against_the_solid() {
+    let solid = solid_rows("solid_guidance_nu0_50x8x2.csv", 3, None);
+    let stored: Vec<f64> = {
+        let mut v: Vec<f64> = solid.iter().map(|(x, _)| *x).collect();
+        v.dedup();
+        v
+    };
+    let solid_at = |x: f64| -> Vec<f64> {
+        solid
+            .iter()
+            .filter(|(s, _)| *s == x)
+            .map(|(_, f)| *f)
+            .collect()
+    };
+    // a continuation through the stored strokes, with steps of at most 1 cm
+    let mut xs = vec![0.0];
+    for w in stored.windows(2) {
+        let m = ((w[1] - w[0]) / 0.01).ceil() as usize;
+        xs.extend((1..=m).map(|i| w[0] + (w[1] - w[0]) * i as f64 / m as f64));
+    }
+    let n = 20;
+    let plain = guidance_sweep(&guidance(n, false), &xs, 6);
+    let warped = guidance_sweep(&guidance(n, true), &xs, 6);
+    let mut worst = [0.0f64; 2];
+    let mut worst_plain = [0.0f64; 2];
+    for &x in &stored {
+        let i = xs.iter().position(|v| (v - x).abs() < 1e-12).unwrap();
+        let s = solid_at(x);
+        let gap = |f: &[f64], k: usize| f[k] / s[k] - 1.0;
+        eprintln!(
+            "x_S = {x}: solid f2 {:.3}, f3 {:.3} Hz; beam − solid: St-Venant {:+.2} %, {:+.2} %; warping {:+.2} %, {:+.2} % (all f: {:?})",
+            s[1],
+            s[2],
+            100.0 * gap(&plain[i], 1),
+            100.0 * gap(&plain[i], 2),
+            100.0 * gap(&warped[i], 1),
+            100.0 * gap(&warped[i], 2),
+            warped[i].iter().map(|f| format!("{f:.3}")).collect::<Vec<_>>()
+        );
+        for k in 0..2 {
+            worst[k] = worst[k].max(gap(&warped[i], k + 1).abs());
+            worst_plain[k] = worst_plain[k].max(gap(&plain[i], k + 1).abs());
+        }
+    }
+    eprintln!("largest gaps, f2 and f3: St-Venant {worst_plain:?}, warping {worst:?}");
+    // issue 22's goal: f2 and f3 within 2 % of the solid at every stored
+    // stroke (the thesis's beam, converged, is up to 16 % and 18 % below)
+    for k in 0..2 {
+        assert!(
+            worst[k] < 0.02 && worst_plain[k] > 0.1,
+            "f{}: warping {worst:?}, St-Venant {worst_plain:?}",
+            k + 2
+        );
     }
 }
