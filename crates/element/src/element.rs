@@ -344,7 +344,10 @@ impl Element {
 
     /// A spatial beam from p to q (thesis (6.2)); local y is the part of `up`
     /// orthogonal to the axis. Stiffness S = AᵀS̄A (3.20) from Timoshenko theory,
-    /// inertia by (2.34) with the 12×12 consistent mass.
+    /// inertia by (2.34) with the 12×12 consistent mass. With
+    /// [`BeamOptions::warping`] the slots are (rp, λp, rq, λq, w_p, w_q), the
+    /// deformations add `warping_p`, `warping_q` = l0 w, and S̄, M̄ are those of
+    /// `warping.rs` (an error if the section has no warping constant).
     pub fn beam(
         p: [f64; 3],
         q: [f64; 3],
@@ -362,39 +365,34 @@ impl Element {
         let l0 = dist(&p, &q);
         positive("beam length", l0)?;
         let r0 = frame_from_axis(&axis, &up)?;
+        let (s_bar, m_bar, modes) = if opts.warping {
+            let (s, m) = warping_beam_matrices(mat, &sec, l0)?;
+            (s, m, 2)
+        } else {
+            let s = DMatrix::from_iterator(6, 6, spatial_beam_s_bar(mat, &sec, l0).iter().copied());
+            let m =
+                DMatrix::from_iterator(12, 12, spatial_beam_m_bar(mat, &sec, l0).iter().copied());
+            (s, m, 0)
+        };
+        let inertia = (opts.inertia && mat.rho > 0.0).then_some(m_bar);
+        let mut e = Self::two_node(
+            l0,
+            r0,
+            &s_bar,
+            inertia,
+            modes,
+            opts.shortening,
+            opts.velocity_transform,
+        );
         if opts.warping {
-            let (s_bar, m_bar) = warping_beam_matrices(mat, &sec, l0)?;
-            let inertia = (opts.inertia && mat.rho > 0.0).then_some(m_bar);
-            let mut e = Self::two_node(
-                l0,
-                r0,
-                &s_bar,
-                inertia,
-                2,
-                opts.shortening,
-                opts.velocity_transform,
-            );
             if let Kind::TwoNode { warping, .. } = &mut e.kind {
                 *warping = true;
             }
             e.names.truncate(6);
             e.names.extend(names(&WARPING_NAMES));
             e.slots.extend([Slot::Modes(1), Slot::Modes(1)]);
-            return Ok(e);
         }
-        let s_bar = DMatrix::from_iterator(6, 6, spatial_beam_s_bar(mat, &sec, l0).iter().copied());
-        let m_bar =
-            DMatrix::from_iterator(12, 12, spatial_beam_m_bar(mat, &sec, l0).iter().copied());
-        let inertia = (opts.inertia && mat.rho > 0.0).then_some(m_bar);
-        Ok(Self::two_node(
-            l0,
-            r0,
-            &s_bar,
-            inertia,
-            0,
-            opts.shortening,
-            opts.velocity_transform,
-        ))
+        Ok(e)
     }
 
     fn two_node(
