@@ -18,6 +18,7 @@ use crate::kernels::{
 use crate::kinetic::{ErasedEnergy, KineticEnergyKernel};
 use crate::section::{positive, Material, SectionShape};
 use crate::superelement::LinearSuperelement;
+use crate::warping::warping_beam_matrices;
 use crate::ElementError;
 use flexmb_dual::{Dual, Real};
 use nalgebra::{DMatrix, Matrix3, Vector3};
@@ -69,6 +70,15 @@ pub struct BeamOptions {
     pub inertia: bool,
     /// The velocity transformation of the co-rotational inertia.
     pub velocity_transform: VelocityTransform,
+    /// Spatial beams only: Vlasov torsion with warping (see `warping.rs`).
+    /// The beam gets one warping coordinate w = φ′ (rad/m) per end, as two
+    /// one-mode [`Slot::Modes`] slots after (rp, λp, rq, λq), and two more
+    /// deformations `warping_p`, `warping_q` = l0 w (rad); its St-Venant
+    /// torsion energy becomes that of a cubic Hermite twist, plus the
+    /// warping energy EI_w/2 ∫φ″² ds. `false` (the default) is the thesis's
+    /// beam exactly.
+    #[serde(default)]
+    pub warping: bool,
 }
 
 impl Default for BeamOptions {
@@ -78,6 +88,7 @@ impl Default for BeamOptions {
             timoshenko: true,
             inertia: true,
             velocity_transform: VelocityTransform::B3,
+            warping: false,
         }
     }
 }
@@ -94,11 +105,14 @@ enum Kind {
         m: f64,
         j: Option<f64>,
     },
-    /// Spatial beam or superelement (k extra modes).
+    /// Spatial beam or superelement (k extra modes); a beam with warping
+    /// has the two warping coordinates as its modes, whose deformations are
+    /// l0 × the coordinate.
     TwoNode {
         kernel: TwoNodeSpatial,
         inertia: Option<SpatialInertia>,
         modes: usize,
+        warping: bool,
     },
     Truss {
         l0: f64,
@@ -206,6 +220,9 @@ fn dist(p: &[f64], q: &[f64]) -> f64 {
         .sqrt()
 }
 
+/// The deformations of a beam with warping after the six of [`SPATIAL_NAMES`].
+const WARPING_NAMES: [&str; 2] = ["warping_p", "warping_q"];
+
 const SPATIAL_NAMES: [&str; 6] = [
     "elongation",
     "torsion",
@@ -237,6 +254,13 @@ impl Element {
         opts: &BeamOptions,
     ) -> Result<Self, ElementError> {
         mat.validate()?;
+        if opts.warping {
+            return Err(ElementError::InvalidProperty {
+                what: "beam option `warping`".into(),
+                value: 1.0,
+                why: "a planar beam has no torsion; warping is an option of spatial beams".into(),
+            });
+        }
         let mut sec = shape.properties(mat.poisson())?;
         if !opts.timoshenko {
             sec = sec.euler_bernoulli();
@@ -320,7 +344,10 @@ impl Element {
 
     /// A spatial beam from p to q (thesis (6.2)); local y is the part of `up`
     /// orthogonal to the axis. Stiffness S = AᵀS̄A (3.20) from Timoshenko theory,
-    /// inertia by (2.34) with the 12×12 consistent mass.
+    /// inertia by (2.34) with the 12×12 consistent mass. With
+    /// [`BeamOptions::warping`] the slots are (rp, λp, rq, λq, w_p, w_q), the
+    /// deformations add `warping_p`, `warping_q` = l0 w, and S̄, M̄ are those of
+    /// `warping.rs` (an error if the section has no warping constant).
     pub fn beam(
         p: [f64; 3],
         q: [f64; 3],
@@ -338,19 +365,34 @@ impl Element {
         let l0 = dist(&p, &q);
         positive("beam length", l0)?;
         let r0 = frame_from_axis(&axis, &up)?;
-        let s_bar = DMatrix::from_iterator(6, 6, spatial_beam_s_bar(mat, &sec, l0).iter().copied());
-        let m_bar =
-            DMatrix::from_iterator(12, 12, spatial_beam_m_bar(mat, &sec, l0).iter().copied());
+        let (s_bar, m_bar, modes) = if opts.warping {
+            let (s, m) = warping_beam_matrices(mat, &sec, l0)?;
+            (s, m, 2)
+        } else {
+            let s = DMatrix::from_iterator(6, 6, spatial_beam_s_bar(mat, &sec, l0).iter().copied());
+            let m =
+                DMatrix::from_iterator(12, 12, spatial_beam_m_bar(mat, &sec, l0).iter().copied());
+            (s, m, 0)
+        };
         let inertia = (opts.inertia && mat.rho > 0.0).then_some(m_bar);
-        Ok(Self::two_node(
+        let mut e = Self::two_node(
             l0,
             r0,
             &s_bar,
             inertia,
-            0,
+            modes,
             opts.shortening,
             opts.velocity_transform,
-        ))
+        );
+        if opts.warping {
+            if let Kind::TwoNode { warping, .. } = &mut e.kind {
+                *warping = true;
+            }
+            e.names.truncate(6);
+            e.names.extend(names(&WARPING_NAMES));
+            e.slots.extend([Slot::Modes(1), Slot::Modes(1)]);
+        }
+        Ok(e)
     }
 
     fn two_node(
@@ -371,6 +413,7 @@ impl Element {
                 kernel: TwoNodeSpatial { l0, r0, bowing },
                 inertia,
                 modes,
+                warping: false,
             },
             vec![
                 Slot::Position3,
@@ -876,8 +919,8 @@ impl Element {
             Kind::PlanarTruss { .. } => "planar truss",
             Kind::PlanarHinge => "planar hinge",
             Kind::PlanarMass { .. } => "planar mass",
-            Kind::TwoNode { modes, .. } => {
-                if *modes > 0 || self.slots.len() > 4 {
+            Kind::TwoNode { modes, warping, .. } => {
+                if !*warping && (*modes > 0 || self.slots.len() > 4) {
                     "superelement"
                 } else {
                     "beam"
@@ -996,6 +1039,19 @@ impl Element {
         }
     }
 
+    /// ∂ε/∂x of a mode deformation: l0 for the warping coordinates of a beam
+    /// (ε = l0 w), 1 for a superelement's modes (ε = η̄).
+    fn mode_scale(&self) -> f64 {
+        match &self.kind {
+            Kind::TwoNode {
+                warping: true,
+                kernel,
+                ..
+            } => kernel.l0,
+            _ => 1.0,
+        }
+    }
+
     /// [`Self::deformations`] in the element's own coordinates, where every
     /// orientation slot starts at the identity.
     fn deformations_local(&self, x: &[f64], prev: Option<&[f64]>, eps: &mut [f64]) {
@@ -1015,8 +1071,9 @@ impl Element {
 
     fn copy_modes(&self, x: &[f64], eps: &mut [f64]) {
         let k = self.mode_count();
-        if k > 0 {
-            eps[6..6 + k].copy_from_slice(&x[14..14 + k]);
+        let c = self.mode_scale();
+        for i in 0..k {
+            eps[6 + i] = c * x[14 + i];
         }
     }
 
@@ -1072,7 +1129,7 @@ impl Element {
             for r in 0..k {
                 let row = &mut jac[(6 + r) * nx..(7 + r) * nx];
                 row.fill(0.0);
-                row[14 + r] = 1.0;
+                row[14 + r] = self.mode_scale();
             }
         }
     }

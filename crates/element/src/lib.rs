@@ -15,7 +15,7 @@
 //!   path (2.34) shared by spatial beams, superelements and rigid bodies.
 //!
 //! Elements: planar beam (5.3), planar truss, planar hinge (5.5), planar mass,
-//! spatial beam (6.2), spatial truss, spatial hinge, point mass, rigid body,
+//! spatial beam (6.2) (optionally with Vlasov warping, one coordinate per end), spatial truss, spatial hinge, point mass, rigid body,
 //! two-node superelement (chapters 2–3) and the Euler-parameter normalization.
 //!
 //! Your own element: implement [`DeformationKernel`] (ε = D(x) once over
@@ -50,6 +50,7 @@ mod kernels;
 mod kinetic;
 mod section;
 mod superelement;
+mod warping;
 
 pub use beam_matrices::{
     equivalent_stiffness, planar_beam_m_bar, planar_beam_s_bar, shear_parameter, spatial_a_diag,
@@ -60,8 +61,12 @@ pub use element::{frame_from_axis, BeamOptions, Element, Slot, FLIP_ANGLE};
 pub use inertia::{VelocityTransform, MAX_MODES};
 pub use kernels::DeformationKernel;
 pub use kinetic::KineticEnergyKernel;
-pub use section::{rectangle_torsion_constant, Material, SectionProperties, SectionShape};
+pub use section::{
+    rectangle_torsion_constant, rectangle_warping_constant, Material, SectionProperties,
+    SectionShape,
+};
 pub use superelement::{FeCell, FeMesh, LinearSuperelement, ModeKind, Provenance, Side};
+pub use warping::{torsion_warping_block, warping_mass_block};
 
 /// Errors of element construction. Messages name the property and what would fix it.
 #[derive(Debug, thiserror::Error, PartialEq)]

@@ -239,6 +239,8 @@ pub fn build_reporting(
     let mut expanded: Vec<Expanded> = vec![];
     let mut element_ids = HashMap::new();
     let mut mode_groups: Vec<(String, usize)> = vec![];
+    // mode groups that the scene's elements restrain (warping ends)
+    let mut restrained: Vec<Select> = vec![];
     let mut part_axes: HashMap<String, PartAxis> = HashMap::new();
     // superelement data by element id, and each file read once
     let mut part_data: HashMap<String, Arc<LinearSuperelement>> = HashMap::new();
@@ -305,7 +307,28 @@ pub fn build_reporting(
                     timoshenko: b.timoshenko,
                     inertia: b.mass,
                     velocity_transform: b.transform,
+                    warping: b.warping.is_some(),
                 };
+                let warp_groups =
+                    match &b.warping {
+                        None => vec![],
+                        Some(_) if dim == Dimension::Planar => return Err(ModelError::invalid(
+                            ctx,
+                            "warping is an option of spatial beams; a planar beam has no torsion",
+                        )),
+                        Some(w) => {
+                            let groups = warping_groups(&id, b.n, w);
+                            for g in &groups {
+                                register_mode_group(&mut mode_groups, &ctx, g, 1)?;
+                            }
+                            for (end, g) in [(&w.p, &groups[0]), (&w.q, &groups[b.n])] {
+                                if *end == WarpingEnd::Restrained {
+                                    restrained.push(Select::Modes(g.clone()));
+                                }
+                            }
+                            groups
+                        }
+                    };
                 let chain = chain_nodes(&id, &b.nodes, &p, &q, b.n, &mut node_at, &mut node_order)?;
                 for (k, (a, bb)) in chain.iter().enumerate() {
                     let (pa, pb) = (node_at[a].clone(), node_at[bb].clone());
@@ -340,16 +363,21 @@ pub fn build_reporting(
                             .map_err(wrap)?
                         }
                     };
+                    let mut attach = vec![
+                        Attach::Pos(a.clone()),
+                        Attach::Orient(a.clone()),
+                        Attach::Pos(bb.clone()),
+                        Attach::Orient(bb.clone()),
+                    ];
+                    if !warp_groups.is_empty() {
+                        attach.push(Attach::Group(warp_groups[k].clone()));
+                        attach.push(Attach::Group(warp_groups[k + 1].clone()));
+                    }
                     expanded.push(Expanded {
                         id: eid,
                         group: id.clone(),
                         element,
-                        attach: vec![
-                            Attach::Pos(a.clone()),
-                            Attach::Orient(a.clone()),
-                            Attach::Pos(bb.clone()),
-                            Attach::Orient(bb.clone()),
-                        ],
+                        attach,
                     });
                 }
             }
@@ -547,16 +575,7 @@ pub fn build_reporting(
                 let gq = share.1.clone().unwrap_or_else(|| format!("{id}.q"));
                 let gf = format!("{id}.f");
                 for (g, k) in [(&gp, kp), (&gq, kq), (&gf, kf)] {
-                    match mode_groups.iter().find(|(n, _)| n == g) {
-                        Some((_, n)) if *n != k => {
-                            return Err(ModelError::invalid(
-                                ctx,
-                                format!("mode group '{g}' has {n} modes elsewhere but {k} here"),
-                            ))
-                        }
-                        Some(_) => {}
-                        None => mode_groups.push((g.clone(), k)),
-                    }
+                    register_mode_group(&mut mode_groups, &ctx, g, k)?;
                 }
                 expanded.push(Expanded {
                     id: id.clone(),
@@ -810,11 +829,50 @@ pub fn build_reporting(
     report(BuildStage::ReferenceConfiguration);
     check_reference_configuration(&mech, &part_axes)?;
     report(BuildStage::DegreesOfFreedom);
-    crate::roles::assign(scene, &mut mech)?;
+    if restrained.is_empty() {
+        crate::roles::assign(scene, &mut mech)?;
+    } else {
+        let mut with_restraints = scene.clone();
+        with_restraints.fixed.extend(restrained);
+        crate::roles::assign(&with_restraints, &mut mech)?;
+    }
     mech.check_output_supports()?;
     report(BuildStage::Loads);
     crate::loads::assign(scene, &mut mech)?;
     Ok(mech)
+}
+
+/// The warping groups of a beam chain of `n` elements, one per node: the
+/// ends' `Shared` names, else `ID.w0` … `ID.wN`.
+fn warping_groups(id: &str, n: usize, w: &WarpingSpec) -> Vec<String> {
+    (0..=n)
+        .map(|k| match (k, &w.p, &w.q) {
+            (0, WarpingEnd::Shared(g), _) => g.clone(),
+            (k, _, WarpingEnd::Shared(g)) if k == n => g.clone(),
+            _ => format!("{id}.w{k}"),
+        })
+        .collect()
+}
+
+/// Adds mode group `g` of `k` coordinates, or checks that an earlier
+/// element gave it the same size.
+fn register_mode_group(
+    groups: &mut Vec<(String, usize)>,
+    ctx: &str,
+    g: &str,
+    k: usize,
+) -> Result<(), ModelError> {
+    match groups.iter().find(|(n, _)| n == g) {
+        Some((_, n)) if *n != k => Err(ModelError::invalid(
+            ctx,
+            format!("mode group '{g}' has {n} modes elsewhere but {k} here"),
+        )),
+        Some(_) => Ok(()),
+        None => {
+            groups.push((g.to_string(), k));
+            Ok(())
+        }
+    }
 }
 
 /// Where a superelement's FE part has its p → q axis: the first column of R0.

@@ -152,6 +152,40 @@ pub struct BeamSpec {
     /// Velocity transformation of the inertia (default B3).
     #[serde(default)]
     pub transform: VelocityTransform,
+    /// Spatial only: Vlasov torsion with warping, one warping coordinate
+    /// w = φ′ (rad/m) per node of the chain, in one-mode groups `ID.w0` …
+    /// `ID.wN` shared by neighbouring elements (N + 1 coordinates for
+    /// `n: N`). `p` and `q` say what the chain's end groups are. Default
+    /// `None`: the thesis's beam (St-Venant torsion, free warping).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warping: Option<WarpingSpec>,
+}
+
+/// The warping ends of a beam chain ([`BeamSpec::warping`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WarpingSpec {
+    /// The end at the first node.
+    pub p: WarpingEnd,
+    /// The end at the last node.
+    pub q: WarpingEnd,
+}
+
+/// What one end of a beam chain with warping does.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum WarpingEnd {
+    /// The end's warping is free: its own group `ID.w0` / `ID.wN`, a degree
+    /// of freedom (the beam's own free end).
+    Free,
+    /// The end cannot warp (w = 0): a clamp or a rigid body. Its group is
+    /// fixed, as if listed under `fixed` as `Modes("ID.w0")` / `Modes("ID.wN")`.
+    Restrained,
+    /// The end's warping coordinate is the named mode group, shared with
+    /// the other elements that name it (another chain's `Shared` end, or
+    /// one of its `ID.wK` groups): two sheets that continue each other.
+    /// The group must hold one coordinate.
+    Shared(String),
 }
 
 /// What an element is.

@@ -181,6 +181,26 @@ pub fn catalogue(rng: &mut StdRng) -> Vec<(String, Element)> {
         })
         .collect();
     v.extend(rotated);
+    // appended last, and rotated with a generator of its own, so that the
+    // random configurations drawn for the elements above stay as they were
+    let warping = Element::beam(
+        [0.1, 0.2, -0.1],
+        [0.3, 0.1, 0.05],
+        [0.0, 0.0, 1.0],
+        &mat,
+        &rect,
+        &BeamOptions {
+            warping: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let warping_rotated = start_rotated(&mut self::rng(0x5ee7), &warping);
+    v.push(("spatial beam with warping".into(), warping));
+    v.push((
+        "spatial beam with warping (nodes start rotated)".into(),
+        warping_rotated,
+    ));
     v
 }
 
