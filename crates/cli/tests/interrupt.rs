@@ -491,6 +491,17 @@ fn chain_1440(dir: &Path) -> PathBuf {
     scene
 }
 
+/// The arguments of a `sweep` of `scene` over load scales 0 to 0.001 in `n`
+/// configurations with `modes` modes each.
+fn chain_load_sweep(scene: &Path, n: &str, modes: &str) -> Vec<String> {
+    let s = scene.to_str().unwrap();
+    [
+        "sweep", s, "--over", "load", "--from", "0", "--to", "0.001", "--n", n, "--modes", modes,
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
 /// The stop latency we accept for the 1440-DOF chain, from the signal to the
 /// end of the computation as the process reports it. Its longest stretch
 /// without a check is one part of a linearization (since the mass assembly
@@ -517,20 +528,8 @@ fn an_interrupted_sweep_of_a_large_model_stops_inside_the_eigen_analysis() {
     let dir = temp_dir("large-sweep");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = chain_1440(&dir);
-    let args = [
-        "sweep",
-        scene.to_str().unwrap(),
-        "--over",
-        "load",
-        "--from",
-        "0",
-        "--to",
-        "0.001",
-        "--n",
-        "100",
-        "--modes",
-        "2",
-    ];
+    let args = chain_load_sweep(&scene, "100", "2");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let out = dir.join("sweep");
     // on a loaded machine the equilibria can take longer than 10 s: then
     // again with a later signal (the stop there is checked too)
@@ -596,20 +595,8 @@ fn an_interrupted_sweep_with_many_modes_stops_inside_the_dense_decomposition() {
     let dir = temp_dir("dense-sweep");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = chain_1440(&dir);
-    let args = [
-        "sweep",
-        scene.to_str().unwrap(),
-        "--over",
-        "load",
-        "--from",
-        "0",
-        "--to",
-        "0.001",
-        "--n",
-        "40",
-        "--modes",
-        "1000",
-    ];
+    let args = chain_load_sweep(&scene, "40", "1000");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let out = dir.join("sweep");
     let mut latencies = vec![];
     let mut in_decompositions = 0;
@@ -715,20 +702,8 @@ fn a_run_that_does_not_stop_within_the_grace_time_is_forced_out() {
     let dir = temp_dir("backstop");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = chain_1440(&dir);
-    let args = [
-        "sweep",
-        scene.to_str().unwrap(),
-        "--over",
-        "load",
-        "--from",
-        "0",
-        "--to",
-        "0.001",
-        "--n",
-        "100",
-        "--modes",
-        "2",
-    ];
+    let args = chain_load_sweep(&scene, "100", "2");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let out = dir.join("sweep");
     let mut tries = vec![];
     for delay in [2, 4, 7] {

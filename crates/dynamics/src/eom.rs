@@ -970,18 +970,22 @@ mod tests {
         .unwrap()
     }
 
+    /// A configuration near the reference: q0 plus a few 1e-3 perturbations.
+    fn off_reference(mech: &Mechanism) -> Vec<f64> {
+        mech.q0()
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + 1e-3 * ((i % 7) as f64 - 3.0))
+            .collect()
+    }
+
     /// A stop request ends the mass assembly inside its element loop with
     /// `Interrupted`, and the next assembly of the same `Dynamics` starts
     /// afresh: its Mq equals that of one never interrupted, bit for bit.
     #[test]
     fn an_interrupted_mass_assembly_leaves_no_trace_in_the_next() {
         let mech = Arc::new(mixed_spatial().build(None).unwrap());
-        let q: Vec<f64> = mech
-            .q0()
-            .iter()
-            .enumerate()
-            .map(|(i, v)| v + 1e-3 * ((i % 7) as f64 - 3.0))
-            .collect();
+        let q = off_reference(&mech);
         let mut clean = Dynamics::new(mech.clone());
         clean.kinematics_at(0.0, &q, None).unwrap();
         clean.forces(0.0, false);
@@ -1009,12 +1013,7 @@ mod tests {
         let mech = Arc::new(scene.build(None).unwrap());
         let mut dy = Dynamics::new(mech.clone());
         let n = dy.n_q();
-        let q: Vec<f64> = mech
-            .q0()
-            .iter()
-            .enumerate()
-            .map(|(i, v)| v + 1e-3 * ((i % 7) as f64 - 3.0))
-            .collect();
+        let q = off_reference(&mech);
         let qd: Vec<f64> = (0..n).map(|i| 0.1 * ((i % 5) as f64 - 2.0)).collect();
         let (mq, rhs) = dy.mass_and_force(0.01, &q, &qd).unwrap();
         let (mq, rhs) = (mq.clone(), rhs.to_vec());
