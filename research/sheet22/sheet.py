@@ -174,15 +174,15 @@ def write_deck(path, L, b, t, nl, nh, nt, mat, loads, nmodes, incs, clamp_kind="
     return len(nodes), len(elems)
 
 
-def parse_dat(path):
-    """Tip displacements of the static steps and, per frequency step, the
-    frequencies and participation factors."""
+def parse_dat(path, tip_set="TIPC"):
+    """Displacements of node set `tip_set` in the static steps and, per
+    frequency step, the frequencies and participation factors."""
     txt = open(path).read()
     blocks = re.split(r"(?=displacements \(vx,vy,vz\))|(?=E I G E N V A L U E   O U T P U T)|(?=P A R T I C I P A T I O N)", txt)
     tips, freqs, parts = [], [], []
     last_tip = None
     for bl in blocks:
-        if bl.startswith("displacements") and "for set TIPC" in bl.splitlines()[0]:
+        if bl.startswith("displacements") and f"for set {tip_set} " in bl.splitlines()[0]:
             line = [l for l in bl.splitlines()[1:] if l.strip()][0]
             v = line.split()
             last_tip = (float(v[1]), float(v[2]), float(v[3]))

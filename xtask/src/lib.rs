@@ -16,6 +16,7 @@ pub mod progress;
 pub mod regress;
 pub mod report;
 pub mod reproduce6;
+pub mod solid6;
 
 /// The workspace root (the parent of this crate).
 pub fn workspace_root() -> std::path::PathBuf {

@@ -121,15 +121,34 @@ pub fn reproduce(
                 .par_iter()
                 .map(|(m, label, i)| sim(m, label, &so(*i), pg))
                 .collect();
-            Ok((refs, models, build_time, curves, runs?))
+            let runs = runs?;
+            let (solid, physical) = crate::solid6::stored_solids(root)?;
+            let beams = crate::solid6::beam_models(root, &crate::solid6::strokes(&solid), pg)?;
+            Ok((
+                refs,
+                models,
+                build_time,
+                curves,
+                runs,
+                (solid, physical, beams),
+            ))
         },
     );
     let unred = unred?;
-    let (refs, models, build_time, curves, mut runs) = rest?;
+    let (refs, models, build_time, curves, mut runs, against_solid) = rest?;
     runs.insert(0, unred);
     let wall = total.elapsed().as_secs_f64();
     write_outputs(
-        out, opts, &setup, &refs, &models, build_time, &curves, &runs, wall,
+        out,
+        opts,
+        &setup,
+        &refs,
+        &models,
+        build_time,
+        &curves,
+        &runs,
+        &against_solid,
+        wall,
     )
     .map_err(io)
 }
@@ -144,6 +163,11 @@ fn write_outputs(
     build_time: f64,
     curves: &[(String, Vec<CurvePoint>)],
     runs: &[Run],
+    against_solid: &(
+        crate::solid6::SolidCurve,
+        Option<crate::solid6::SolidCurve>,
+        Vec<crate::solid6::BeamModel>,
+    ),
     wall: f64,
 ) -> std::io::Result<Vec<ModelRow>> {
     let curve = |n: &str| {
@@ -479,11 +503,19 @@ fn write_outputs(
         "{}",
         crate::pictures::section(&figs, setup.lambda_max, &mode_freqs)
     );
+    let (solid, physical, beams) = against_solid;
+    let _ = writeln!(
+        s,
+        "{}",
+        crate::solid6::section(&mut figs, out, solid, physical.as_ref(), beams)?
+    );
     let _ = writeln!(s, "## Figures\n");
     let _ = writeln!(
         s,
         "{}",
-        figs.markdown(|f| f != "speed_vs_error" && !f.starts_with("mech_"))
+        figs.markdown(|f| f != "speed_vs_error"
+            && !f.starts_with("mech_")
+            && !f.starts_with("solid_f"))
     );
     std::fs::write(out.join("report.md"), s)?;
     Ok(rows_out)

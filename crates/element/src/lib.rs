@@ -81,6 +81,14 @@ pub enum ElementError {
         /// Why it is invalid.
         why: String,
     },
+    /// A property the element needs is not given.
+    #[error("missing {what}: {why}")]
+    MissingProperty {
+        /// The property.
+        what: String,
+        /// Why it is needed, and how to give it.
+        why: String,
+    },
     /// Degenerate element geometry.
     #[error("invalid element geometry: {0}")]
     Geometry(String),

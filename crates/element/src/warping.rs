@@ -37,9 +37,8 @@ pub fn warping_mass_block(rho_iw: f64, l: f64) -> [[f64; 2]; 2] {
 
 /// The section's warping constant, or an error that says how to give one.
 pub(crate) fn warping_constant(sec: &SectionProperties) -> Result<f64, ElementError> {
-    sec.iw.ok_or_else(|| ElementError::InvalidProperty {
+    sec.iw.ok_or_else(|| ElementError::MissingProperty {
         what: "section warping constant `iw`".into(),
-        value: f64::NAN,
         why: "a beam with warping needs I_w (m⁶): a Rectangle section gives it (h³t³/144), a User section must list `iw`".into(),
     })
 }

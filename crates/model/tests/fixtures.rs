@@ -29,6 +29,33 @@ fn spatial_straight_guidance_has_44_dofs() {
         .all(|c| !m.coordinate_name(*c).ends_with(".l0")));
 }
 
+/// The guidance with warping beams: 2 × 20 × 5 free deformations minus the 6
+/// loop-closure conditions, plus the 2 × 19 warping coordinates left free
+/// between the restrained ends.
+#[test]
+fn spatial_straight_guidance_with_warping_has_232_dofs() {
+    let m = scene("straight_guidance_spatial_warping.ron")
+        .build(None)
+        .unwrap();
+    assert_eq!(m.n_dof(), 232, "{}", m.summary());
+    let names: Vec<&str> = m.dofs.iter().map(|c| m.coordinate_name(*c)).collect();
+    // with deformation DOFs, the warping is in the elements' `warping_p` and
+    // `warping_q` (l0 w at each end): 19 free per flexure, the two
+    // restrained ends not among them
+    for f in ["flexure1", "flexure2"] {
+        let w: Vec<&&str> = names
+            .iter()
+            .filter(|n| n.starts_with(&format!("{f}.")) && n.contains(".warping_"))
+            .collect();
+        assert_eq!(w.len(), 19, "{f}: {w:?}");
+        assert!(
+            !w.iter()
+                .any(|n| **n == format!("{f}.1.warping_p") || **n == format!("{f}.20.warping_q")),
+            "{w:?}"
+        );
+    }
+}
+
 #[test]
 fn planar_straight_guidance_has_17_dofs() {
     let m = scene("straight_guidance_planar.ron").build(None).unwrap();
@@ -50,7 +77,7 @@ fn every_fixture_scene_parses_strictly_and_builds() {
             n += 1;
         }
     }
-    assert!(n >= 9, "{n} scenes");
+    assert!(n >= 11, "{n} scenes");
 }
 
 /// `build_reporting` names every stage once, in order, and builds the same
