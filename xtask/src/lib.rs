@@ -1,4 +1,4 @@
-//! `cargo xtask`: regenerates the thesis benchmarks (chapters 5 and 6) with
+//! `cargo xtask`: regenerates the thesis benchmarks (chapters 2, 3, 5 and 6) with
 //! the thesis's numbers side by side, speed against error, and the CI
 //! regression of stored eigenfrequency curves, and fuzzes the scene parser,
 //! validator and equations of motion (`cargo xtask fuzz`). See README.md,
@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod ch2;
+pub mod ch3;
 pub mod ch5;
 pub mod ch6;
 pub mod curves;
@@ -15,6 +16,7 @@ pub mod pictures;
 pub mod progress;
 pub mod regress;
 pub mod report;
+pub mod reproduce3;
 pub mod reproduce6;
 pub mod solid6;
 

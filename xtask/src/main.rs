@@ -1,4 +1,4 @@
-//! `cargo xtask reproduce ch2|ch5|ch6|all`, `cargo xtask regress` and `cargo xtask fuzz`.
+//! `cargo xtask reproduce ch2|ch3|ch5|ch6|all`, `cargo xtask regress` and `cargo xtask fuzz`.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -19,6 +19,7 @@ struct Cli {
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Chapter {
     Ch2,
+    Ch3,
     Ch5,
     Ch6,
     All,
@@ -38,7 +39,7 @@ enum FuzzTarget {
 enum Cmd {
     /// Regenerate a chapter's results into OUT/chN (CSV, SVG, report.md).
     Reproduce {
-        /// ch2, ch5, ch6 or all.
+        /// ch2, ch3, ch5, ch6 or all.
         chapter: Chapter,
         /// Output directory.
         #[arg(long, default_value = "results")]
@@ -49,6 +50,9 @@ enum Cmd {
         /// Store the recomputed curves as the new fixtures instead of comparing.
         #[arg(long)]
         update: bool,
+        /// Only this chapter's curves (ch2, ch3, ch5 or ch6; default all).
+        #[arg(long, value_enum)]
+        chapter: Option<Chapter>,
     },
     /// Fuzz the scene parser, the validator and one evaluation of the
     /// equations of motion with mutated fixture scenes, for a bounded time.
@@ -102,7 +106,9 @@ fn main() -> ExitCode {
             };
             reproduce(&root, &out, chapter, &pg)
         }
-        Cmd::Regress { update } => regress(&root, update, &pg),
+        Cmd::Regress { update, chapter } => {
+            regress(&root, update, chapter.unwrap_or(Chapter::All), &pg)
+        }
         Cmd::Fuzz {
             seconds,
             seed,
@@ -160,6 +166,15 @@ fn reproduce(
         ));
         summary.extend(rows.iter().map(xtask::reproduce6::summary_line));
     }
+    if matches!(ch, Chapter::Ch3 | Chapter::All) {
+        let t = std::time::Instant::now();
+        xtask::reproduce3::reproduce(&out.join("ch3"), pg)?;
+        summary.push(format!(
+            "chapter 3 in {:.0} s: {}",
+            t.elapsed().as_secs_f64(),
+            out.join("ch3/report.md").display()
+        ));
+    }
     if matches!(ch, Chapter::Ch5 | Chapter::All) {
         let t = std::time::Instant::now();
         let rows = xtask::ch5::reproduce(root, &out.join("ch5"), pg)?;
@@ -187,12 +202,24 @@ fn reproduce(
     Ok(())
 }
 
-fn regress(root: &std::path::Path, update: bool, pg: &Progress) -> Result<(), String> {
-    let sets = [
-        xtask::regress::recompute_ch2(root, pg)?,
-        xtask::regress::recompute_ch5(root, pg)?,
-        xtask::regress::recompute_ch6(root, pg)?,
+fn regress(
+    root: &std::path::Path,
+    update: bool,
+    only: Chapter,
+    pg: &Progress,
+) -> Result<(), String> {
+    type Recompute = fn(&std::path::Path, &Progress) -> Result<xtask::regress::Recomputed, String>;
+    let chapters: [(Chapter, Recompute); 4] = [
+        (Chapter::Ch2, xtask::regress::recompute_ch2),
+        (Chapter::Ch3, xtask::ch3::recompute),
+        (Chapter::Ch5, xtask::regress::recompute_ch5),
+        (Chapter::Ch6, xtask::regress::recompute_ch6),
     ];
+    let sets = chapters
+        .iter()
+        .filter(|(c, _)| only == Chapter::All || *c == only)
+        .map(|(_, f)| f(root, pg))
+        .collect::<Result<Vec<_>, String>>()?;
     if update {
         for s in &sets {
             xtask::regress::update(s)?;

@@ -117,8 +117,20 @@ pub fn quasi_static_curve(
     node: &str,
     count: usize,
 ) -> Result<Vec<CurvePoint>, String> {
-    let ctx = |e: flexmb_reduction::ReductionError| format!("{}: {e}", model.name);
     let probe = NodeProbe::new(&model.mech, node)?;
+    quasi_static_curve_of(model, t, lambdas, count, &|x| probe.displacement_in(x))
+}
+
+/// [`quasi_static_curve`] with the curve's `position` any function of the
+/// equilibrium's nodal coordinates x (a rotation angle, say).
+pub fn quasi_static_curve_of(
+    model: &Model,
+    t: f64,
+    lambdas: &[f64],
+    count: usize,
+    position: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Result<Vec<CurvePoint>, String> {
+    let ctx = |e: flexmb_reduction::ReductionError| format!("{}: {e}", model.name);
     let mut m = model.instance()?;
     // all frequencies, for the highest; a reduced model keeps all of them
     let all = m.n_coordinates();
@@ -130,7 +142,7 @@ pub fn quasi_static_curve(
         .into_iter()
         .map(|p| CurvePoint {
             lambda: p.load_scale,
-            position: probe.displacement_in(&p.equilibrium.x),
+            position: position(&p.equilibrium.x),
             highest: p.frequencies.last().copied().unwrap_or(0.0),
             freqs: p.frequencies.into_iter().take(keep).collect(),
         })

@@ -1,4 +1,4 @@
-//! The CI regression: the eigenfrequency curves of chapters 2, 5 and 6 (unreduced
+//! The CI regression: the eigenfrequency curves of chapters 2, 3, 5 and 6 (unreduced
 //! and every reduced model) are recomputed and compared with those stored in
 //! `fixtures/curves/` (`cargo xtask regress --update` stores them).
 
@@ -21,6 +21,15 @@ fn assert_matches_fixtures(r: &xtask::regress::Recomputed, models: usize) {
 fn chapter_2_curves_match_the_stored_ones() {
     let root = xtask::workspace_root();
     assert_matches_fixtures(&recompute_ch2(&root, &Progress::hidden()).unwrap(), 2);
+}
+
+#[test]
+fn chapter_3_curves_match_the_stored_ones() {
+    let root = xtask::workspace_root();
+    assert_matches_fixtures(
+        &xtask::ch3::recompute(&root, &Progress::hidden()).unwrap(),
+        3,
+    );
 }
 
 #[test]

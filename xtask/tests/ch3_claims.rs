@@ -1,0 +1,79 @@
+//! Chapter 3 §3.5.1's claims on the short sheet flexure (Figs 3.10–3.11),
+//! on the stored curves' mesh (`xtask::ch3::CURVE_MESH`):
+//! - ω1 and ω3 agree for SE-C and SE-CW, and for NLB once its beam has the
+//!   wide sheet's plate modulus;
+//! - ω2 (torsion) is far too low for NLB (free warping at the clamped ends)
+//!   and far too high for SE-C (warping suppressed at every interface),
+//!   with SE-CW between them;
+//! - the flexure turns by about ±40° at ±0.4 N m.
+
+use xtask::ch3::{compute, Ch3Options, Kind, CURVE_MESH};
+use xtask::progress::Progress;
+
+#[test]
+fn the_short_sheet_flexure_shows_the_thesis_pattern() {
+    let dir = std::env::temp_dir().join(format!("flexmb-ch3-claims-{}", std::process::id()));
+    let o = Ch3Options {
+        mesh: CURVE_MESH,
+        n_moments: 11,
+    };
+    let r = compute(&dir, &o, &Progress::hidden());
+    let _ = std::fs::remove_dir_all(&dir);
+    let (curves, _) = r.unwrap();
+    let get = |k: Kind| &curves.iter().find(|c| c.0 == k).unwrap().1;
+    let (nlb, sec, secw) = (get(Kind::Nlb), get(Kind::SeC), get(Kind::SeCw));
+    for i in 0..nlb.len() {
+        eprintln!(
+            "phi {:+6.1}° ({:+6.1}, {:+6.1}): NLB {:?}, SE-C {:?}, SE-CW {:?}",
+            nlb[i].position[0],
+            sec[i].position[0],
+            secw[i].position[0],
+            nlb[i].freqs,
+            sec[i].freqs,
+            secw[i].freqs
+        );
+    }
+    let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+    // ±0.4 N m turns the superelement flexure by about ±43° (the thesis
+    // ±40°; EI of the beam alone gives 48.5°)
+    for i in [0, nlb.len() - 1] {
+        let phi = secw[i].position[0].abs();
+        assert!((38.0..46.0).contains(&phi), "phi = {phi}°");
+    }
+    // the bending modes ω1 and ω3 do not involve warping: SE-C and SE-CW agree
+    for i in 0..nlb.len() {
+        for k in [0, 2] {
+            assert!(
+                rel(sec[i].freqs[k], secw[i].freqs[k]) < 1e-6,
+                "point {i}, ω{}: SE-C {}, SE-CW {}",
+                k + 1,
+                sec[i].freqs[k],
+                secw[i].freqs[k]
+            );
+        }
+    }
+    // the beam agrees with them at rest once given the plate modulus of the
+    // wide sheet, E/(1 − ν²) with ν = E/2G − 1 (the solid has the Poisson
+    // term, the beam has none): a factor √(1/(1 − ν²)) on ω1 and ω3
+    let nu: f64 = 2.1e11 / (2.0 * 8e10) - 1.0;
+    let plate = (1.0 / (1.0 - nu * nu)).sqrt();
+    let rest = nlb.len() / 2;
+    for k in [0, 2] {
+        let f = nlb[rest].freqs[k] * plate;
+        assert!(
+            rel(f, secw[rest].freqs[k]) < 0.01
+                && rel(nlb[rest].freqs[k], secw[rest].freqs[k]) > 0.03,
+            "ω{} at rest: NLB × plate factor {f}, SE-CW {}",
+            k + 1,
+            secw[rest].freqs[k]
+        );
+    }
+    // ω2, the torsion mode: far too low for NLB, far too high for SE-C
+    for i in 0..nlb.len() {
+        let w2 = [nlb[i].freqs[1], secw[i].freqs[1], sec[i].freqs[1]];
+        assert!(
+            w2[0] < 0.9 * w2[1] && w2[2] > 1.5 * w2[1],
+            "point {i}, ω2 NLB, SE-CW, SE-C: {w2:?}"
+        );
+    }
+}
