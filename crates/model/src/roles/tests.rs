@@ -292,22 +292,3 @@ fn free_chains_are_chosen_locally_as_the_dense_svd_chooses() {
         9
     );
 }
-
-/// `flexmb info`'s work on large free chains (cargo test --release -- --ignored).
-#[test]
-#[ignore]
-fn timing_free_chain() {
-    let text = std::fs::read_to_string(root().join("fixtures/scenes/tumbling_beam.ron")).unwrap();
-    for n in [400, 1000, 5000, 20000] {
-        let scene = Scene::from_ron_str(&text.replace("n: 2)", &format!("n: {n})"))).unwrap();
-        let before = fallbacks();
-        let t = std::time::Instant::now();
-        let m = scene.build(None).unwrap();
-        eprintln!(
-            "n = {n}: {:?}, {} DOFs, fallbacks {}",
-            t.elapsed(),
-            m.n_dof(),
-            fallbacks() - before
-        );
-    }
-}
