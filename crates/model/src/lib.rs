@@ -29,6 +29,7 @@
 
 mod build;
 mod chart;
+pub mod constraints;
 mod error;
 mod loads;
 mod local_span;
@@ -42,6 +43,7 @@ mod time_function;
 
 pub use build::{BuildStage, CodeElement};
 pub use chart::{ChartSwitch, EulerChart, CHART_SWITCH_RATIO};
+pub use constraints::ConstraintDiagnosis;
 pub use error::ModelError;
 pub use mechanism::*;
 pub use scene::*;
