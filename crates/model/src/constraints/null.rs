@@ -54,7 +54,8 @@ pub(crate) fn left_null_space(
     what: &str,
 ) -> Result<NullSpace, ModelError> {
     let scale = rows.iter().map(|r| norm(r)).fold(0.0f64, f64::max);
-    let core = peel(rows, n_cols);
+    let all: Vec<usize> = (0..rows.len()).collect();
+    let core = peel(rows, &all);
     let blocks = blocks(rows, &core, n_cols);
     let mut vectors = vec![];
     let mut largest_block = 0;
@@ -72,31 +73,41 @@ pub(crate) fn left_null_space(
     })
 }
 
-/// Rows that remain after repeatedly removing rows with a private column.
-fn peel(rows: &[Vec<(usize, f64)>], n_cols: usize) -> Vec<usize> {
-    let norms: Vec<f64> = rows.iter().map(|r| norm(r)).collect();
-    let significant = |r: usize| {
-        let n = norms[r];
-        rows[r].iter().filter(move |(_, v)| v.abs() > PEEL_TOL * n)
-    };
-    let mut count = vec![0usize; n_cols];
-    let mut col_rows: Vec<Vec<usize>> = vec![vec![]; n_cols];
-    for r in 0..rows.len() {
-        for (c, _) in significant(r) {
+/// The rows of `subset` that remain after repeatedly removing rows with a
+/// column that no other remaining row of `subset` touches.
+fn peel(rows: &[Vec<(usize, f64)>], subset: &[usize]) -> Vec<usize> {
+    let mut local: std::collections::HashMap<usize, usize> = Default::default();
+    let mut sig: Vec<Vec<usize>> = Vec::with_capacity(subset.len());
+    for r in subset {
+        let n = norm(&rows[*r]);
+        let cs: Vec<usize> = rows[*r]
+            .iter()
+            .filter(|(_, v)| v.abs() > PEEL_TOL * n)
+            .map(|(c, _)| {
+                let next = local.len();
+                *local.entry(*c).or_insert(next)
+            })
+            .collect();
+        sig.push(cs);
+    }
+    let mut count = vec![0usize; local.len()];
+    let mut col_rows: Vec<Vec<usize>> = vec![vec![]; local.len()];
+    for (k, cs) in sig.iter().enumerate() {
+        for c in cs {
             count[*c] += 1;
-            col_rows[*c].push(r);
+            col_rows[*c].push(k);
         }
     }
-    let mut alive = vec![true; rows.len()];
-    let mut stack: Vec<usize> = (0..rows.len())
-        .filter(|r| significant(*r).any(|(c, _)| count[*c] == 1))
+    let mut alive = vec![true; subset.len()];
+    let mut stack: Vec<usize> = (0..subset.len())
+        .filter(|k| sig[*k].iter().any(|c| count[*c] == 1))
         .collect();
-    while let Some(r) = stack.pop() {
-        if !alive[r] {
+    while let Some(k) = stack.pop() {
+        if !alive[k] {
             continue;
         }
-        alive[r] = false;
-        for (c, _) in significant(r) {
+        alive[k] = false;
+        for c in &sig[k] {
             count[*c] -= 1;
             if count[*c] == 1 {
                 if let Some(&o) = col_rows[*c].iter().find(|o| alive[**o]) {
@@ -105,7 +116,10 @@ fn peel(rows: &[Vec<(usize, f64)>], n_cols: usize) -> Vec<usize> {
             }
         }
     }
-    (0..rows.len()).filter(|r| alive[*r]).collect()
+    (0..subset.len())
+        .filter(|k| alive[*k])
+        .map(|k| subset[k])
+        .collect()
 }
 
 fn find(parent: &mut [usize], mut i: usize) -> usize {
@@ -298,11 +312,20 @@ fn by_balls(
             if !seen.insert(key.clone()) {
                 continue;
             }
-            let sub: Vec<usize> = key
+            // only the rows of the ball that survive peeling within it can
+            // combine to zero (most balls peel away completely)
+            let global: Vec<usize> = key
                 .iter()
-                .flat_map(|u| unit_rows[*u].iter().copied())
+                .flat_map(|u| unit_rows[*u].iter().map(|i| block[*i]))
                 .collect();
-            let global: Vec<usize> = sub.iter().map(|i| block[*i]).collect();
+            let global = peel(rows, &global);
+            if global.is_empty() {
+                continue;
+            }
+            let sub: Vec<usize> = global
+                .iter()
+                .map(|r| block.binary_search(r).expect("in the block"))
+                .collect();
             let found = dense_null(rows, &global, scale, what)?;
             if !found.is_empty() {
                 for v in found {
