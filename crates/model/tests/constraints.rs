@@ -48,11 +48,14 @@ fn rigid(beams: &[&str], hinges: &[&str], released: &[(&str, &str)]) -> String {
     s
 }
 
+/// A mechanism's part in RON pieces: (nodes, elements, fixed, beams, hinges).
+type Part = (String, String, String, Vec<String>, Vec<String>);
+
 /// A planar four-bar in the xy-plane built spatially, with ground pivots
 /// `{t}GA` at (x0, 0) and `{t}GD` at (x0 + 2, 0): crank `{t}crank`,
 /// coupler `{t}coupler`, rocker `{t}rocker`, hinges `{t}hA` … `{t}hD`.
 /// Returns (nodes, elements, fixed, beams, hinges).
-fn four_bar(t: &str, x0: f64) -> (String, String, String, Vec<String>, Vec<String>) {
+fn four_bar(t: &str, x0: f64) -> Part {
     let n = |s: &str| format!("{t}{s}");
     let nodes = format!(
         r#"(id: "{ga}", at: [{x0}, 0.0, 0.0]), (id: "{a}", position_of: Some("{ga}")),
@@ -82,15 +85,12 @@ fn four_bar(t: &str, x0: f64) -> (String, String, String, Vec<String>, Vec<Strin
     ]
     .join("\n");
     let fixed = format!(r#"Node("{}"), Node("{}"), "#, n("GA"), n("GD"));
-    let beams = ["crank", "coupler", "rocker"].map(|s| n(s)).to_vec();
-    let hinges = ["hA", "hB", "hC", "hD"].map(|s| n(s)).to_vec();
+    let beams = ["crank", "coupler", "rocker"].map(n).to_vec();
+    let hinges = ["hA", "hB", "hC", "hD"].map(n).to_vec();
     (nodes, elements, fixed, beams, hinges)
 }
 
-fn scene_of(
-    parts: &[(String, String, String, Vec<String>, Vec<String>)],
-    released: &[(&str, &str)],
-) -> Scene {
+fn scene_of(parts: &[Part], released: &[(&str, &str)]) -> Scene {
     let (mut nodes, mut elements, mut fixed, mut rig) =
         (String::new(), String::new(), String::new(), String::new());
     for (n, e, f, b, h) in parts {

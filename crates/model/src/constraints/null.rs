@@ -18,9 +18,19 @@
 //!    echelon form (pivot: the largest remaining entry), which separates loops
 //!    that share no equation, and then by pairwise support reduction: a basis
 //!    vector is replaced by its combination with another one whenever that
-//!    cancels entries and leaves fewer nonzeros (loops that share equations,
-//!    such as two cells of a ladder, come out as the two cells rather than a
-//!    cell and the outer loop). The span is unchanged by both.
+//!    cancels entries and leaves fewer nonzeros. The span is unchanged by
+//!    both.
+//! 4. **Balls** (blocks of two or more null vectors and at most
+//!    [`BALL_MAX_ROWS`] rows): loops that share equations (two cells of a
+//!    ladder, the thesis's two parallelograms sharing the CrossBar) need
+//!    more than pairwise steps. Around every unit (an element, or one fixed
+//!    coordinate), the ball of units within graph distance r grows (r = 1,
+//!    2, …) until the rows of the ball, peeled within the ball, have a null
+//!    combination of their own; those (localized as in 3) are candidates,
+//!    taken smallest ball first while independent of those taken (Gram–
+//!    Schmidt, relative residual 1e-6), and the basis of 3 completes them if
+//!    needed. A ball's null vector is one of the block: its rows vanish
+//!    outside the ball's columns.
 
 use crate::roles::{check_dense, RANK_TOL};
 use crate::ModelError;
