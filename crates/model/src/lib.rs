@@ -9,6 +9,10 @@
 //! culprit: unknown or duplicate ids, non-positive properties, non-finite
 //! values, malformed RON (line and column), inconsistent roles, and over- or
 //! under-constrained mechanisms (found by an SVD of the constraint Jacobian).
+//! [`Scene::diagnose_constraints`] ([`constraints`]) explains the latter
+//! without building: each over-constraint as a loop of elements with its
+//! equations, weights and direction, each under-constraint as the
+//! coordinates of its mode.
 //!
 //! ```
 //! use flexmb_model::Scene;

@@ -363,6 +363,14 @@ impl std::fmt::Display for super::ConstraintDiagnosis {
             "  {} equations in closed loops; largest block decomposed by a dense SVD: {} equations",
             self.core_equations, self.largest_block
         )?;
+        if self.largest_block > super::null::BALL_MAX_ROWS {
+            writeln!(
+                f,
+                "  note: the largest block ({} equations) is above {}: its basis is localized by reduced row echelon form and pairwise reduction only, not by balls, and its dense SVD takes time cubic in its size",
+                self.largest_block,
+                super::null::BALL_MAX_ROWS
+            )?;
+        }
         if self.is_exact() {
             write!(f, "no over- or under-constraints")?;
             if !self.under_checked {

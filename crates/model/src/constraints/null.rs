@@ -200,7 +200,13 @@ fn dense_null(
                 a[(i, j)] += *v;
             }
         }
-        let d = flexmb_linalg::svd(a.as_ref()).map_err(|source| ModelError::Computation {
+        // U must be complete (m × m): the thin SVD gives it when m ≤ columns
+        let svd = if m <= cols.len() {
+            flexmb_linalg::thin_svd
+        } else {
+            flexmb_linalg::svd
+        };
+        let d = svd(a.as_ref()).map_err(|source| ModelError::Computation {
             what: what.to_string(),
             source,
         })?;
