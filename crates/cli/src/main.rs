@@ -57,6 +57,13 @@ enum Command {
     Info {
         /// Scene file (RON).
         scene: PathBuf,
+        /// Instead, diagnose the constraints at the reference configuration:
+        /// each over-constraint as a loop of elements with its equations,
+        /// weights and direction, each under-constraint as the coordinates
+        /// of its mode (works on scenes whose build fails for being over-
+        /// or under-constrained).
+        #[arg(long)]
+        constraints: bool,
     },
     /// Static equilibrium under the loads and gravity at t = --time.
     Static {
@@ -259,6 +266,11 @@ fn build(scene: &Scene, path: &Path) -> Result<flexmb_model::Mechanism, Failure>
     mech.map_err(|e| match e {
         // a numerical failure on a valid scene, not bad input
         flexmb_model::ModelError::Computation { .. } => Failure::Compute(e.to_string()),
+        flexmb_model::ModelError::OverConstrained { .. }
+        | flexmb_model::ModelError::UnderConstrained { .. } => Failure::Input(format!(
+            "{e}\n(`flexmb info --constraints {}` names each over-constraint's loop and direction, and each undetermined motion)",
+            path.display()
+        )),
         _ => Failure::Input(e.to_string()),
     })
 }
@@ -285,7 +297,13 @@ fn main() -> ExitCode {
 /// Runs a command.
 fn run(command: Command) -> Result<(), Failure> {
     match command {
-        Command::Info { scene } => info(&scene),
+        Command::Info { scene, constraints } => {
+            if constraints {
+                info_constraints(&scene)
+            } else {
+                info(&scene)
+            }
+        }
         Command::Static {
             scene,
             time,
@@ -356,6 +374,22 @@ fn info(path: &Path) -> Result<(), Failure> {
             say!("  {}", mech.coordinate_name(i.target));
         }
     }
+    Ok(())
+}
+
+/// `flexmb info --constraints`: the over- and under-constraints of a scene
+/// ([`flexmb_model::ConstraintDiagnosis`]); exits 0 whatever it finds.
+fn info_constraints(path: &Path) -> Result<(), Failure> {
+    let scene = Scene::load(path).map_err(|e| Failure::Input(e.to_string()))?;
+    let start = std::time::Instant::now();
+    let d = scene
+        .diagnose_constraints(path.parent())
+        .map_err(|e| match e {
+            flexmb_model::ModelError::Computation { .. } => Failure::Compute(e.to_string()),
+            _ => Failure::Input(e.to_string()),
+        })?;
+    say!("{d}");
+    say!("diagnosed in {:.2} s", start.elapsed().as_secs_f64());
     Ok(())
 }
 

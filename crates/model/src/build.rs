@@ -114,6 +114,25 @@ pub fn build_reporting(
     extra: &[CodeElement],
     report: &mut dyn FnMut(BuildStage),
 ) -> Result<Mechanism, ModelError> {
+    let (mut mech, roles_scene) = assemble(scene, base_dir, extra, report)?;
+    report(BuildStage::DegreesOfFreedom);
+    crate::roles::assign(&roles_scene, &mut mech)?;
+    mech.check_output_supports()?;
+    report(BuildStage::Loads);
+    crate::loads::assign(scene, &mut mech)?;
+    Ok(mech)
+}
+
+/// Every stage of the build before the roles: the mechanism with its
+/// coordinates, deformations and elements placed (roles not assigned yet),
+/// and the scene the roles are to be taken from (the scene itself, or a copy
+/// whose `fixed` also lists the restrained warping groups).
+pub(crate) fn assemble<'s>(
+    scene: &'s Scene,
+    base_dir: Option<&Path>,
+    extra: &[CodeElement],
+    report: &mut dyn FnMut(BuildStage),
+) -> Result<(Mechanism, std::borrow::Cow<'s, Scene>), ModelError> {
     report(BuildStage::Nodes);
     let dim = scene.dimension;
     let nd = match dim {
@@ -804,7 +823,7 @@ pub fn build_reporting(
     }
     let n_x = x0.len();
     let n_eps = eps_names.len();
-    let mut mech = Mechanism {
+    let mech = Mechanism {
         name: scene.name.clone(),
         dimension: dim,
         nodes,
@@ -828,18 +847,13 @@ pub fn build_reporting(
     mech.check_outputs()?;
     report(BuildStage::ReferenceConfiguration);
     check_reference_configuration(&mech, &part_axes)?;
-    report(BuildStage::DegreesOfFreedom);
     if restrained.is_empty() {
-        crate::roles::assign(scene, &mut mech)?;
+        Ok((mech, std::borrow::Cow::Borrowed(scene)))
     } else {
         let mut with_restraints = scene.clone();
         with_restraints.fixed.extend(restrained);
-        crate::roles::assign(&with_restraints, &mut mech)?;
+        Ok((mech, std::borrow::Cow::Owned(with_restraints)))
     }
-    mech.check_output_supports()?;
-    report(BuildStage::Loads);
-    crate::loads::assign(scene, &mut mech)?;
-    Ok(mech)
 }
 
 /// The warping groups of a beam chain of `n` elements, one per node: the

@@ -9,6 +9,10 @@
 //! culprit: unknown or duplicate ids, non-positive properties, non-finite
 //! values, malformed RON (line and column), inconsistent roles, and over- or
 //! under-constrained mechanisms (found by an SVD of the constraint Jacobian).
+//! [`Scene::diagnose_constraints`] ([`constraints`]) explains the latter
+//! without building: each over-constraint as a loop of elements with its
+//! equations, weights and direction, each under-constraint as the
+//! coordinates of its mode.
 //!
 //! ```
 //! use flexmb_model::Scene;
@@ -29,6 +33,7 @@
 
 mod build;
 mod chart;
+pub mod constraints;
 mod error;
 mod loads;
 mod local_span;
@@ -42,6 +47,7 @@ mod time_function;
 
 pub use build::{BuildStage, CodeElement};
 pub use chart::{ChartSwitch, EulerChart, CHART_SWITCH_RATIO};
+pub use constraints::ConstraintDiagnosis;
 pub use error::ModelError;
 pub use mechanism::*;
 pub use scene::*;

@@ -19,7 +19,8 @@ mod sparse;
 #[cfg(test)]
 mod tests;
 
-use dense::{choose_dense, names_in, null_spaces, RANK_TOL};
+pub(crate) use dense::RANK_TOL;
+use dense::{choose_dense, names_in, null_spaces};
 use local::regular_by_local_bounds;
 use memory::dense_bytes;
 pub(crate) use memory::{check_dense, human_bytes, physical_memory};
@@ -72,7 +73,7 @@ pub(crate) fn sparse_jacobian(mech: &Mechanism, x: &[f64]) -> Vec<Vec<(usize, f6
 
 /// Role of a coordinate or deformation while the roles are assigned.
 #[derive(Clone, Copy, PartialEq, Debug)]
-enum R {
+pub(crate) enum R {
     Free,
     Fixed,
     Rigid,
@@ -323,7 +324,11 @@ fn greedy(
     Ok(chosen)
 }
 
-pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelError> {
+/// The roles the scene gives (thesis (6.4)): fixed and prescribed nodal
+/// coordinates, rigid and prescribed deformations (the Euler-parameter
+/// normalizations rigid unless the whole orientation is fixed); every other
+/// entry [`R::Free`]. Records the inputs and their roles in `mech`.
+pub(crate) fn mark(scene: &Scene, mech: &mut Mechanism) -> Result<(Vec<R>, Vec<R>), ModelError> {
     let n_x = mech.n_x();
     let n_eps = mech.n_eps();
     let mut xr = vec![R::Free; n_x];
@@ -408,6 +413,13 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
             function: p.function.clone(),
         });
     }
+    Ok((xr, er))
+}
+
+pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelError> {
+    let n_x = mech.n_x();
+    let n_eps = mech.n_eps();
+    let (mut xr, mut er) = mark(scene, mech)?;
     // ---- the constraint Jacobian at the reference configuration, and the DOFs
     let free: Vec<usize> = (0..n_x).filter(|i| xr[*i] == R::Free).collect();
     let mut free_pos = vec![usize::MAX; n_x];

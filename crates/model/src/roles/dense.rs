@@ -15,7 +15,8 @@ fn dense_of(rows: &[Vec<(usize, f64)>], m: usize, n: usize) -> Mat<f64> {
     j
 }
 
-pub(super) const RANK_TOL: f64 = 1e-9;
+/// Relative singular-value threshold of the numerical rank.
+pub(crate) const RANK_TOL: f64 = 1e-9;
 
 /// Rank and null spaces of a (row-normalized) matrix: (rank, left null
 /// vectors as columns, right null space as columns), from the SVD of
