@@ -36,6 +36,7 @@ mod mechanism;
 mod naming;
 mod orientation;
 mod outputs;
+mod partition;
 mod roles;
 mod scene;
 mod time_function;
@@ -44,6 +45,7 @@ pub use build::{BuildStage, CodeElement};
 pub use chart::{ChartSwitch, EulerChart, CHART_SWITCH_RATIO};
 pub use error::ModelError;
 pub use mechanism::*;
+pub use partition::PartitionSwitch;
 pub use scene::*;
 pub use time_function::TimeFunction;
 
