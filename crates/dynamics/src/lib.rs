@@ -66,7 +66,7 @@ pub use flexmb_ode::{Control, Stats};
 pub use linearize::{Linearization, LinearizedAt};
 pub use momentum::Momentum;
 pub use outputs::OutputTable;
-pub use partition::{KEEP_PREFERENCE, PARTITION_SWITCH_RATIO};
+pub use partition::{PARTITION_IMPROVEMENT, PARTITION_SWITCH_RATIO};
 pub use simulate::{
     integrate_explicit, with_failure_cause, FirstOrder, Integrator, OutputPoint, SimulationOptions,
     Trajectory,

@@ -10,27 +10,43 @@
 //! ([`flexmb_model::Mechanism::partition_eligible`]) and the dependent ones
 //! that are not eligible (those come first, they stay dependent), picking
 //! at each step the column with the largest part orthogonal to those
-//! picked, a current dependent one weighted by [`KEEP_PREFERENCE`]. The
-//! picked columns are a well-conditioned square block; the others are the
-//! new DOFs.
+//! picked. The smallest of those parts, min |R_ii|, estimates the smallest
+//! singular value of the picked block; the same QR over the current set
+//! alone estimates its own. The set changes only if the new one's is
+//! [`PARTITION_IMPROVEMENT`] times larger and at least
+//! [`PARTITION_RECOVERY`] of what the current set had when it was chosen:
+//! near a singular configuration of the mechanism itself (a stretched
+//! toggle), where every set degrades alike, it stays, and the run ends
+//! there as before, naming what failed.
 
 use crate::{Dynamics, DynamicsError};
-use flexmb_model::{Mechanism, PartitionSwitch, XRole};
+use flexmb_model::{Mechanism, PartitionSwitch};
 use std::sync::Arc;
+
+/// q and q̇ in a new dependent set.
+type StateInSet = (Vec<f64>, Vec<f64>);
 
 /// Re-partition when the pivot ratio of J falls below this fraction of its
 /// value just after the dependent set was chosen.
 pub const PARTITION_SWITCH_RATIO: f64 = 0.1;
 
-/// A current dependent coordinate's column counts this many times its
-/// length in the choice: the set changes only for a clearly better one.
-pub const KEEP_PREFERENCE: f64 = 2.0;
+/// A new dependent set is taken only if its smallest singular value
+/// (estimated by min |R_ii| of the pivoted QR) is this many times that of
+/// the current set.
+pub const PARTITION_IMPROVEMENT: f64 = 4.0;
+
+/// … and at least this fraction of the current set's estimate when it was
+/// chosen: a new set must restore the conditioning the mechanism had.
+pub const PARTITION_RECOVERY: f64 = 0.5;
 
 /// The state of a run's watch on the dependent set.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PartitionWatch {
-    /// The pivot ratio of J just after the set was chosen.
+    /// The pivot ratio of J just after the set was chosen (or last found
+    /// to be the best one).
     pub(crate) reference: f64,
+    /// The estimated smallest singular value of J when the set was chosen.
+    pub(crate) quality: f64,
 }
 
 impl PartitionWatch {
@@ -48,50 +64,71 @@ impl Dynamics {
             return None;
         }
         Some(PartitionWatch {
-            reference: self.kin.pivot_ratio_at_x(),
+            reference: self.kin.pivot_ratio(),
+            quality: self.current_set_quality().unwrap_or(0.0),
         })
     }
 
     /// The best-conditioned dependent set at the current (solved)
     /// configuration, by the column-pivoted QR of the module docs, as nodal
-    /// coordinate indices in the order of the picks. `None` if the
-    /// constraint Jacobian has no square regular block over the candidates
-    /// (a picked column is at the rounding level of the largest).
-    pub fn best_dependent_set(&self) -> Option<Vec<usize>> {
-        let mech = &self.mech;
-        let eligible = mech.partition_eligible();
-        let forced: Vec<usize> = mech
+    /// coordinate indices in the order of the picks, with its estimated
+    /// smallest singular value. `None` if the constraint Jacobian has no
+    /// square regular block over the candidates (a picked column is at the
+    /// rounding level of the largest).
+    pub fn best_dependent_set(&self) -> Option<(Vec<usize>, f64)> {
+        let eligible = self.mech.partition_eligible();
+        let forced: Vec<usize> = self
+            .mech
             .dependent
             .iter()
             .copied()
             .filter(|i| !eligible.contains(i))
             .collect();
-        let cols: Vec<usize> = forced.iter().chain(&eligible).copied().collect();
-        let a = constraint_jacobian(mech, |k| self.kin.element_jacobian(k), &cols);
-        let n_c = mech.constraint_rows.len();
-        let weight: Vec<f64> = cols
-            .iter()
-            .map(|i| match mech.x_roles[*i] {
-                XRole::Dependent(_) => KEEP_PREFERENCE,
-                _ => 1.0,
-            })
-            .collect();
-        let picks = pivoted_qr_picks(a, n_c, cols.len(), forced.len(), &weight)?;
-        Some(picks.into_iter().map(|c| cols[c]).collect())
+        self.pivoted_picks(&forced, &eligible)
     }
 
-    /// [`best_dependent_set`](Self::best_dependent_set) if it is not the
-    /// current one.
-    pub fn better_dependent_set(&self) -> Option<Vec<usize>> {
-        let mut best = self.best_dependent_set()?;
+    /// The same estimate for the current dependent set.
+    fn current_set_quality(&self) -> Option<f64> {
+        let eligible = self.mech.partition_eligible();
+        let (forced, rest): (Vec<usize>, Vec<usize>) = self
+            .mech
+            .dependent
+            .iter()
+            .partition(|i| !eligible.contains(i));
+        self.pivoted_picks(&forced, &rest).map(|(_, r)| r)
+    }
+
+    /// The pivoted QR of D_c,x over the columns `forced` (taken in order)
+    /// and `free` (picked): the picks as nodal coordinates and min |R_ii|.
+    fn pivoted_picks(&self, forced: &[usize], free: &[usize]) -> Option<(Vec<usize>, f64)> {
+        let cols: Vec<usize> = forced.iter().chain(free).copied().collect();
+        let a = constraint_jacobian(&self.mech, |k| self.kin.element_jacobian(k), &cols);
+        let n_c = self.mech.constraint_rows.len();
+        let (picks, r_min) = pivoted_qr_picks(a, n_c, cols.len(), forced.len())?;
+        Some((picks.into_iter().map(|c| cols[c]).collect(), r_min))
+    }
+
+    /// [`best_dependent_set`](Self::best_dependent_set) if it is another
+    /// set than the current one, [`PARTITION_IMPROVEMENT`] times better
+    /// conditioned, and at least [`PARTITION_RECOVERY`] times as well as
+    /// `chosen` (the current set's estimate when it was chosen).
+    pub(crate) fn better_dependent_set(&self, chosen: f64) -> Option<Vec<usize>> {
+        let (mut best, r_best) = self.best_dependent_set()?;
         best.sort_unstable();
         let mut now = self.mech.dependent.clone();
         now.sort_unstable();
-        (best != now).then_some(best)
+        let r_now = self.current_set_quality().unwrap_or(0.0);
+        let better =
+            r_best > PARTITION_IMPROVEMENT * r_now && r_best >= PARTITION_RECOVERY * chosen;
+        (best != now && better).then_some(best)
     }
 
     /// Chooses the dependent set again at (t, q, q̇) if a better one exists
-    /// ([`best_dependent_set`](Self::best_dependent_set)): rebuilds the
+    /// ([`best_dependent_set`](Self::best_dependent_set), better as for the
+    /// run's watch: [`PARTITION_IMPROVEMENT`] times the current set's
+    /// estimate and [`PARTITION_RECOVERY`] of `chosen`, the estimate the
+    /// current set had when it was chosen; 0 to require only the first):
+    /// rebuilds the
     /// dynamics with it, its position solve starting from the current
     /// configuration, and returns q, q̇ in it (mapped through x, ẋ). `None`
     /// if the set stays. The switch is appended to `log`.
@@ -100,10 +137,11 @@ impl Dynamics {
         t: f64,
         q: &[f64],
         qd: &[f64],
+        chosen: f64,
         log: &mut Vec<PartitionSwitch>,
-    ) -> Result<Option<(Vec<f64>, Vec<f64>)>, DynamicsError> {
+    ) -> Result<Option<StateInSet>, DynamicsError> {
         self.kinematics_at(t, q, Some(qd))?;
-        let Some(best) = self.best_dependent_set() else {
+        let Some(best) = self.better_dependent_set(chosen) else {
             return Ok(None);
         };
         let mut mech = (*self.mech).clone();
@@ -160,16 +198,16 @@ fn constraint_jacobian<'a>(
 
 /// Column-pivoted Householder QR of the column-major `rows × cols` matrix
 /// `a`: the first `forced` columns are taken in order, then `rows − forced`
-/// more, each the one of largest weighted norm orthogonal to those taken
-/// (`weight` per column). Returns the taken columns, or `None` when one of
-/// them is at the rounding level of the largest column.
+/// more, each the one with the largest part orthogonal to those taken.
+/// Returns the taken columns and the smallest of those parts (min |R_ii|),
+/// or `None` when one of them is at the rounding level of the largest
+/// column.
 fn pivoted_qr_picks(
     mut a: Vec<f64>,
     rows: usize,
     cols: usize,
     forced: usize,
-    weight: &[f64],
-) -> Option<Vec<usize>> {
+) -> Option<(Vec<usize>, f64)> {
     let col_norm = |a: &[f64], c: usize, from: usize| -> f64 {
         a[c * rows + from..(c + 1) * rows]
             .iter()
@@ -180,31 +218,28 @@ fn pivoted_qr_picks(
     let largest = (0..cols).map(|c| col_norm(&a, c, 0)).fold(0.0f64, f64::max);
     let mut taken = vec![false; cols];
     let mut picks = Vec::with_capacity(rows);
+    let mut r_min = f64::INFINITY;
     for s in 0..rows {
         let c = if s < forced {
             s
         } else {
-            (0..cols).filter(|c| !taken[*c]).max_by(|x, y| {
-                (weight[*x] * col_norm(&a, *x, s)).total_cmp(&(weight[*y] * col_norm(&a, *y, s)))
-            })?
+            (0..cols)
+                .filter(|c| !taken[*c])
+                .max_by(|x, y| col_norm(&a, *x, s).total_cmp(&col_norm(&a, *y, s)))?
         };
         let norm = col_norm(&a, c, s);
-        if !(norm > 1e3 * f64::EPSILON * largest) {
+        // (a NaN norm fails too)
+        if norm.is_nan() || norm <= 1e3 * f64::EPSILON * largest {
             return None;
         }
+        r_min = r_min.min(norm);
         taken[c] = true;
         picks.push(c);
         // the reflection H = I − 2vvᵀ/vᵀv taking column c's rows s.. to ∓|.|e_s
         let mut v: Vec<f64> = a[c * rows + s..(c + 1) * rows].to_vec();
         v[0] += if v[0] >= 0.0 { norm } else { -norm };
         let vv: f64 = v.iter().map(|x| x * x).sum();
-        if vv == 0.0 {
-            continue;
-        }
-        for d in 0..cols {
-            if taken[d] && d != c {
-                continue;
-            }
+        for d in (0..cols).filter(|d| !taken[*d] || *d == c) {
             let col = &mut a[d * rows + s..(d + 1) * rows];
             let dot: f64 = col.iter().zip(&v).map(|(x, y)| x * y).sum();
             let f = 2.0 * dot / vv;
@@ -213,7 +248,7 @@ fn pivoted_qr_picks(
             }
         }
     }
-    Some(picks)
+    Some((picks, r_min))
 }
 
 #[cfg(test)]
@@ -225,16 +260,18 @@ mod tests {
         // 2 × 4, column-major: c0 = (1, 0), c1 = (1, 1e-3), c2 = (0, 1),
         // c3 = (2, 0)
         let a = vec![1.0, 0.0, 1.0, 1e-3, 0.0, 1.0, 2.0, 0.0];
-        let w = [1.0; 4];
-        // free: the largest, c3, then the one most orthogonal to it, c2
-        assert_eq!(pivoted_qr_picks(a.clone(), 2, 4, 0, &w), Some(vec![3, 2]));
+        let picks = |forced| pivoted_qr_picks(a.clone(), 2, 4, forced).unwrap();
+        // free: the largest, c3, then the one most orthogonal to it, c2;
+        // R = diag(2, 1)
+        assert_eq!(picks(0), (vec![3, 2], 1.0));
         // c0 forced: then c2 (c3 and c1 are nearly parallel to c0)
-        assert_eq!(pivoted_qr_picks(a.clone(), 2, 4, 1, &w), Some(vec![0, 2]));
-        // a weight of 3 on c0 makes it the first free pick
-        let w0 = [3.0, 1.0, 1.0, 1.0];
-        assert_eq!(pivoted_qr_picks(a.clone(), 2, 4, 0, &w0), Some(vec![0, 2]));
+        assert_eq!(picks(1).0, vec![0, 2]);
+        // c0 and c1 forced: |R_22| = 1e-3, the block's smallest singular
+        // value to first order
+        let (p, r) = pivoted_qr_picks(vec![1.0, 0.0, 1.0, 1e-3], 2, 2, 2).unwrap();
+        assert_eq!(p, vec![0, 1]);
+        assert!((r - 1e-3).abs() < 1e-15, "{r}");
         // rank one: no regular square block
-        let r1 = vec![1.0, 0.0, 2.0, 0.0];
-        assert_eq!(pivoted_qr_picks(r1, 2, 2, 0, &[1.0; 2]), None);
+        assert_eq!(pivoted_qr_picks(vec![1.0, 0.0, 2.0, 0.0], 2, 2, 0), None);
     }
 }

@@ -441,11 +441,11 @@ impl StepWatch {
         let Some(w) = &mut self.partition else {
             return false;
         };
-        let now = dy.kin.pivot_ratio_at_x();
+        let now = dy.kin.pivot_ratio();
         if !w.degraded(now) {
             return false;
         }
-        if dy.better_dependent_set().is_some() {
+        if dy.better_dependent_set(w.quality).is_some() {
             return true;
         }
         w.reference = now;
@@ -695,9 +695,13 @@ impl Dynamics {
     /// that was, q and q̇ are mapped through x and ẋ, and the integration
     /// restarts there (Adams and generalized-α restart at low order; the
     /// evaluation counts include the restarts). A body may so turn through
-    /// any number of revolutions. The trajectory's q and q̇ are given in the
-    /// chart the run started with, and `self` is in that chart again when
-    /// this returns.
+    /// any number of revolutions. Likewise, with nodal coordinates as DOFs,
+    /// the dependent set is chosen again where its Jacobian has got
+    /// ill-conditioned ([`switch_partition`](Self::switch_partition); a
+    /// beam with rigid elongations turned by 90°), with a restart there
+    /// ([`Trajectory::partition_switches`]). The trajectory's q and q̇ are
+    /// given in the chart and dependent set the run started with, and
+    /// `self` is in them again when this returns.
     pub fn simulate_with(
         &mut self,
         t0: f64,
@@ -749,13 +753,15 @@ impl Dynamics {
             (q, qd) = (qs, qds);
             // the dependent set first, in the chart whose J the watch
             // measured; a new set or chart has a reference of its own
-            if partition.is_some_and(|w| w.degraded(self.kin.pivot_ratio_at_x())) {
-                if let Some((q1, qd1)) =
-                    self.switch_partition(t, &q, &qd, &mut traj.partition_switches)?
-                {
+            if let Some(w) = partition.filter(|w| w.degraded(self.kin.pivot_ratio())) {
+                let log = &mut traj.partition_switches;
+                if let Some((q1, qd1)) = self.switch_partition(t, &q, &qd, w.quality, log)? {
                     (q, qd) = (q1, qd1);
+                    partition = self.partition_watch();
+                } else if let Some(w) = &mut partition {
+                    // the set stays: the watch goes on from here
+                    w.reference = self.kin.pivot_ratio();
                 }
-                partition = self.partition_watch();
             }
             if let Some((q1, qd1)) =
                 self.switch_charts(t, &q, &qd, &[], &mut traj.chart_switches)?

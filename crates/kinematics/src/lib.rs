@@ -268,16 +268,15 @@ impl Kinematics {
         self.first_order_valid = false;
     }
 
-    /// The smallest over the largest pivot of the LU factorization of the
-    /// kinematic Jacobian J (with respect to the dependent coordinates) at
-    /// the solved configuration, factorized there first if its
-    /// factorization is of another one; 0 where J is singular. A cheap
-    /// measure of how well the dependent coordinates are determined, for
-    /// watching it change along a motion (its value depends on the units
-    /// of the rows and columns; only its ratio to an earlier value means
-    /// something).
-    pub fn pivot_ratio_at_x(&mut self) -> f64 {
-        self.ensure_lu_at_x();
+    /// The smallest over the largest pivot of the last LU factorization of
+    /// the kinematic Jacobian J (with respect to the dependent
+    /// coordinates), 0 when it failed: a measure of how well the dependent
+    /// coordinates are determined, for watching it along a motion. It is of
+    /// the configuration of the last factorization, which chord steps keep
+    /// while they converge fast (within a step or so of the current one);
+    /// reading it changes nothing. Its value depends on the units of the
+    /// rows and columns: only its ratio to an earlier value means something.
+    pub fn pivot_ratio(&self) -> f64 {
         if self.lu_valid {
             self.lu.pivot_ratio
         } else {
