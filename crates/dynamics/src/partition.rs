@@ -128,10 +128,9 @@ impl Dynamics {
     /// run's watch: [`PARTITION_IMPROVEMENT`] times the current set's
     /// estimate and [`PARTITION_RECOVERY`] of `chosen`, the estimate the
     /// current set had when it was chosen; 0 to require only the first):
-    /// rebuilds the
-    /// dynamics with it, its position solve starting from the current
-    /// configuration, and returns q, q̇ in it (mapped through x, ẋ). `None`
-    /// if the set stays. The switch is appended to `log`.
+    /// rebuilds the dynamics with it, its position solve starting from the
+    /// current configuration, and returns q, q̇ in it (mapped through x,
+    /// ẋ). `None` if the set stays. The switch is appended to `log`.
     pub fn switch_partition(
         &mut self,
         t: f64,
