@@ -822,8 +822,12 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
     let pts = outcome.points;
     let wall = start.elapsed().as_secs_f64();
     say!(
-        "{} configurations, {k} modes each, in {wall:.2} s",
-        pts.len()
+        "{} configurations, {k} modes each, in {wall:.2} s{}",
+        pts.len(),
+        match outcome.chart_switches.len() {
+            0 => String::new(),
+            c => format!(", {c} chart switches of free orientations on the way"),
+        }
     );
     let sw = FrequencySweep {
         title: &mech.name,

@@ -80,6 +80,9 @@ pub(crate) fn summary(r: &Response) -> String {
     ) + &match r.chart_switches.len() {
         0 => String::new(),
         n => format!(", {n} chart switches of free orientations (each a restart)"),
+    } + &match r.partition_switches.len() {
+        0 => String::new(),
+        n => format!(", {n} changes of the dependent nodal coordinates (each a restart)"),
     }
 }
 

@@ -46,6 +46,7 @@ mod linearize;
 mod momentum;
 mod nodal_eom;
 mod outputs;
+mod partition;
 mod reactions;
 mod simulate;
 mod statics;
@@ -65,6 +66,7 @@ pub use flexmb_ode::{Control, Stats};
 pub use linearize::{Linearization, LinearizedAt};
 pub use momentum::Momentum;
 pub use outputs::OutputTable;
+pub use partition::{PARTITION_IMPROVEMENT, PARTITION_SWITCH_RATIO};
 pub use simulate::{
     integrate_explicit, with_failure_cause, FirstOrder, Integrator, OutputPoint, SimulationOptions,
     Trajectory,

@@ -3,9 +3,10 @@
 //! side), and in residual form with tangents for generalized-α.
 
 use crate::culprit::{integration_error, StateLayout};
+use crate::partition::PartitionWatch;
 use crate::{Dynamics, DynamicsError};
 use faer::Mat;
-use flexmb_model::{ChartSwitch, Coordinate, EulerChart, Mechanism};
+use flexmb_model::{ChartSwitch, Coordinate, EulerChart, Mechanism, PartitionSwitch};
 use flexmb_ode::{
     Adams, AdamsOptions, Control, Dopri5, Dopri5Options, GeneralizedAlpha, GeneralizedAlphaOptions,
     OdeSystem, Output, RhsError, RhsErrorKind, SecondOrderSystem, Stats, Tolerance,
@@ -126,6 +127,10 @@ pub struct Trajectory {
     /// ([`flexmb_model::EulerChart`]); each one restarted the integrator.
     /// `q` and `qd` are always given in the chart the run started with.
     pub chart_switches: Vec<ChartSwitch>,
+    /// Changes of the dependent nodal coordinates during the run (where J
+    /// of the old ones got ill-conditioned, see
+    /// [`Dynamics::switch_partition`]); each one restarted the integrator.
+    pub partition_switches: Vec<PartitionSwitch>,
 }
 
 impl Trajectory {
@@ -139,6 +144,7 @@ impl Trajectory {
             stopped: false,
             x: vec![],
             chart_switches: vec![],
+            partition_switches: vec![],
         }
     }
 }
@@ -381,6 +387,8 @@ pub fn with_failure_cause(e: DynamicsError, last_failure: Option<&(f64, String)>
 #[derive(Default)]
 struct StepWatch {
     charts: Vec<EulerChart>,
+    /// The watch on the dependent nodal coordinates, if they may change.
+    partition: Option<PartitionWatch>,
     /// x at the last accepted step.
     x: Rc<RefCell<Vec<f64>>>,
     /// (t, q, q̇) where a chart must switch.
@@ -391,9 +399,10 @@ struct StepWatch {
 }
 
 impl StepWatch {
-    fn new(dy: &Dynamics) -> Self {
+    fn new(dy: &Dynamics, partition: Option<PartitionWatch>) -> Self {
         Self {
             charts: dy.mech.euler_charts(),
+            partition,
             x: Rc::new(RefCell::new(dy.kin.x().to_vec())),
             switch_at: None,
             last_failure: None,
@@ -415,13 +424,32 @@ impl StepWatch {
         with_failure_cause(e, self.last_failure.as_ref())
     }
 
-    fn accepted(&mut self, dy: &Dynamics, t: f64, q: &[f64], qd: &[f64]) -> Control {
+    fn accepted(&mut self, dy: &mut Dynamics, t: f64, q: &[f64], qd: &[f64]) -> Control {
         self.x.borrow_mut().copy_from_slice(dy.kin.x());
-        if self.charts.iter().any(|c| c.needs_switch(q).is_some()) {
+        if self.charts.iter().any(|c| c.needs_switch(q).is_some()) || self.partition_degraded(dy) {
             self.switch_at = Some((t, q.to_vec(), qd.to_vec()));
             return Control::Stop;
         }
         Control::Continue
+    }
+
+    /// Whether J of the dependent coordinates has got ill-conditioned at
+    /// the configuration of the last evaluation and another set is better
+    /// there; where the set is still the best, the reference of the
+    /// watch becomes the pivot ratio now.
+    fn partition_degraded(&mut self, dy: &mut Dynamics) -> bool {
+        let Some(w) = &mut self.partition else {
+            return false;
+        };
+        let now = dy.kin.pivot_ratio();
+        if !w.degraded(now) {
+            return false;
+        }
+        if dy.better_dependent_set(w.quality).is_some() {
+            return true;
+        }
+        w.reference = now;
+        false
     }
 }
 
@@ -452,7 +480,7 @@ impl OdeSystem for FirstOrder<'_> {
     fn step_accepted(&mut self, t: f64, y: &[f64]) -> Control {
         let n = self.dy.n_q();
         match &mut self.watch {
-            Some(w) => w.accepted(self.dy, t, &y[..n], &y[n..]),
+            Some(w) => w.accepted(&mut *self.dy, t, &y[..n], &y[n..]),
             None => Control::Continue,
         }
     }
@@ -634,6 +662,7 @@ impl Dynamics {
             .get_or_insert_with(|| flexmb_kinematics::Kinematics::new(mech.clone()));
         kin.set_newton_options(self.kin.newton_options());
         kin.set_guess(self.kin.x());
+        kin.set_branch(self.kin.branch());
         kin.solve(q, t)
             .map_err(|e| DynamicsError::Kinematics { t, source: e })?;
         Ok(kin.x().to_vec())
@@ -666,9 +695,13 @@ impl Dynamics {
     /// that was, q and q̇ are mapped through x and ẋ, and the integration
     /// restarts there (Adams and generalized-α restart at low order; the
     /// evaluation counts include the restarts). A body may so turn through
-    /// any number of revolutions. The trajectory's q and q̇ are given in the
-    /// chart the run started with, and `self` is in that chart again when
-    /// this returns.
+    /// any number of revolutions. Likewise, with nodal coordinates as DOFs,
+    /// the dependent set is chosen again where its Jacobian has got
+    /// ill-conditioned ([`switch_partition`](Self::switch_partition); a
+    /// beam with rigid elongations turned by 90°), with a restart there
+    /// ([`Trajectory::partition_switches`]). The trajectory's q and q̇ are
+    /// given in the chart and dependent set the run started with, and
+    /// `self` is in them again when this returns.
     pub fn simulate_with(
         &mut self,
         t0: f64,
@@ -689,6 +722,7 @@ impl Dynamics {
         if let Some((q1, qd1)) = self.switch_charts(t, &q, &qd, &[], &mut traj.chart_switches)? {
             (q, qd) = (q1, qd1);
         }
+        let mut partition = self.partition_watch();
         let mut times = opts.output_times.clone();
         loop {
             let seg_opts = SimulationOptions {
@@ -703,6 +737,7 @@ impl Dynamics {
                 &start_mech,
                 &mut traj,
                 &mut observer,
+                &mut partition,
             )?;
             // the counts of every segment between chart switches
             traj.stats.accumulate(&stats);
@@ -715,9 +750,25 @@ impl Dynamics {
             }
             t = ts;
             self.kinematics_at(t, &qs, None)?;
-            (q, qd) = self
-                .switch_charts(t, &qs, &qds, &[], &mut traj.chart_switches)?
-                .unwrap_or((qs, qds));
+            (q, qd) = (qs, qds);
+            // the dependent set first, in the chart whose J the watch
+            // measured; a new set or chart has a reference of its own
+            if let Some(w) = partition.filter(|w| w.degraded(self.kin.pivot_ratio())) {
+                let log = &mut traj.partition_switches;
+                if let Some((q1, qd1)) = self.switch_partition(t, &q, &qd, w.quality, log)? {
+                    (q, qd) = (q1, qd1);
+                    partition = self.partition_watch();
+                } else if let Some(w) = &mut partition {
+                    // the set stays: the watch goes on from here
+                    w.reference = self.kin.pivot_ratio();
+                }
+            }
+            if let Some((q1, qd1)) =
+                self.switch_charts(t, &q, &qd, &[], &mut traj.chart_switches)?
+            {
+                (q, qd) = (q1, qd1);
+                partition = self.partition_watch();
+            }
             times.retain(|&tau| tau > ts);
             if times.is_empty() {
                 break;
@@ -740,15 +791,17 @@ impl Dynamics {
         start_mech: &Arc<Mechanism>,
         traj: &mut Trajectory,
         observer: &mut impl FnMut(&mut OutputPoint<'_>) -> Control,
+        partition: &mut Option<PartitionWatch>,
     ) -> Result<(Stats, Option<StateAt>, bool), DynamicsError> {
         let n = self.n_q();
         let t_end = *opts.output_times.last().expect("output times");
         let out = Output::Times(opts.output_times.clone());
         let mut out_dy = Dynamics::new(self.mech.clone());
+        out_dy.kin.set_branch(self.kin.branch());
         out_dy.kin.set_newton_options(self.kin.newton_options());
         out_dy.load_factor = self.load_factor;
         out_dy.load_scale = self.load_scale;
-        let watch = StepWatch::new(self);
+        let watch = StepWatch::new(self, partition.take());
         let last_x = watch.x.clone();
         let mut failure: Option<DynamicsError> = None;
         let mut emit = |t: f64, q: &[f64], qd: &[f64]| -> Control {
@@ -795,6 +848,7 @@ impl Dynamics {
                     |e| integration_error(&mech, StateLayout::FirstOrder, e),
                 );
                 let watch = sys.watch.expect("set above");
+                *partition = watch.partition;
                 let (stats, stopped) = match run {
                     Ok(r) => r,
                     Err(e @ DynamicsError::Integration { .. }) => return Err(watch.with_cause(e)),
@@ -833,6 +887,7 @@ impl Dynamics {
                     },
                 );
                 sys.dy.kin.set_stop(None);
+                *partition = sys.watch.partition;
                 let sol = match solved {
                     Ok(sol) => sol,
                     // the start-up mass matrix is singular: the projection's
@@ -959,11 +1014,13 @@ impl Dynamics {
 
     /// Rebuilds this dynamics for `mech` (the same scene with other DOF
     /// roles), keeping its settings: Newton options, load factor and scale,
-    /// evaluation count.
-    fn replace_mechanism(&mut self, mech: Arc<Mechanism>) {
+    /// evaluation count, and the branch of periodic deformations.
+    pub(crate) fn replace_mechanism(&mut self, mech: Arc<Mechanism>) {
         let newton = self.kin.newton_options();
         let (lf, ls, ev) = (self.load_factor, self.load_scale, self.evaluations);
+        let branch = self.kin.branch().to_vec();
         *self = Dynamics::new(mech);
+        self.kin.set_branch(&branch);
         self.kin.set_newton_options(newton);
         self.load_factor = lf;
         self.load_scale = ls;

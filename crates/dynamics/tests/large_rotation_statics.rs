@@ -274,3 +274,46 @@ fn the_roll_up_with_nodal_dofs_switches_charts_and_reaches_the_full_circle() {
         "{tip:?} against {reference:?}"
     );
 }
+
+/// When a node's orientation really cannot go on (issue 15 item 4), the
+/// error names the node and the reason: the tip's Euler parameter B.l3,
+/// a DOF of its chart, is held and driven to 0.9999 (the tip turned by
+/// 178.4°, B.l0 = 0.014). Its chart cannot switch, since the parameter
+/// that would become dependent is held, so the dependent B.l0 approaches
+/// zero where that chart is singular.
+#[test]
+fn a_held_euler_parameter_driven_to_the_charts_singularity_names_the_node() {
+    let mut scene = cantilever_scene(true, 8, L, 0.0);
+    scene.dofs = DofChoice::NodalCoordinates;
+    let mech = Arc::new(scene.build(None).unwrap());
+    let l3 = mech.x_names.iter().position(|s| s == "B.l3").unwrap();
+    let slot = mech
+        .dofs
+        .iter()
+        .position(|c| *c == flexmb_model::Coordinate::Node(l3))
+        .expect("B.l3 is a DOF of B's chart");
+    let mut dy = Dynamics::new(mech.clone());
+    let opts = StaticOptions {
+        load_steps: 8,
+        held: vec![(slot, 0.9999)],
+        ..Default::default()
+    };
+    let err = dy
+        .static_equilibrium(0.0, &mech.q0(), &opts)
+        .expect_err("the held chart is singular at the target");
+    let msg = err.to_string();
+    for part in ["node B", "B.l0", "approaches zero"] {
+        assert!(msg.contains(part), "`{part}` missing from: {msg}");
+    }
+    // the same held value short of the singular region is reached: the
+    // failure is the chart's, not the solver's
+    let near = StaticOptions {
+        held: vec![(slot, 0.99)],
+        ..opts
+    };
+    let mut dy = Dynamics::new(mech.clone());
+    let sol = dy.static_equilibrium(0.0, &mech.q0(), &near).unwrap();
+    let x = dy.kinematics().x();
+    assert!((x[l3] - 0.99).abs() < 1e-12, "{}", x[l3]);
+    assert!(sol.chart_switches.iter().all(|c| c.node != "B"));
+}

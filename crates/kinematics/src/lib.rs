@@ -268,6 +268,37 @@ impl Kinematics {
         self.first_order_valid = false;
     }
 
+    /// The smallest over the largest pivot of the last LU factorization of
+    /// the kinematic Jacobian J (with respect to the dependent
+    /// coordinates), 0 when it failed: a measure of how well the dependent
+    /// coordinates are determined, for watching it along a motion. It is of
+    /// the configuration of the last factorization, which chord steps keep
+    /// while they converge fast (within a step or so of the current one);
+    /// reading it changes nothing. Its value depends on the units of the
+    /// rows and columns: only its ratio to an earlier value means something.
+    pub fn pivot_ratio(&self) -> f64 {
+        if self.lu_valid {
+            self.lu.pivot_ratio
+        } else {
+            0.0
+        }
+    }
+
+    /// The deformations of the last converged solve: the branch that
+    /// periodic deformations (hinge angles over many turns) are continued
+    /// from in the next solve.
+    pub fn branch(&self) -> &[f64] {
+        &self.prev_eps
+    }
+
+    /// Continues periodic deformations from `eps` (the [`branch`](Self::branch)
+    /// of another kinematics of the same scene, e.g. of the mechanism in
+    /// another chart) in the next solve: a new kinematics would otherwise
+    /// unwrap a hinge angle against zero, not against the turns it has made.
+    pub fn set_branch(&mut self, eps: &[f64]) {
+        self.prev_eps.copy_from_slice(eps);
+    }
+
     /// Factorizations of the kinematic Jacobian so far (a cost measure).
     pub fn factorizations(&self) -> u64 {
         self.factorizations

@@ -41,6 +41,7 @@ mod mechanism;
 mod naming;
 mod orientation;
 mod outputs;
+mod partition;
 mod roles;
 mod scene;
 mod time_function;
@@ -50,6 +51,7 @@ pub use chart::{ChartSwitch, EulerChart, CHART_SWITCH_RATIO};
 pub use constraints::ConstraintDiagnosis;
 pub use error::ModelError;
 pub use mechanism::*;
+pub use partition::PartitionSwitch;
 pub use scene::*;
 pub use time_function::TimeFunction;
 

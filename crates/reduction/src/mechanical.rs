@@ -444,6 +444,8 @@ impl MechanicalModel for ReducedModel {
                 stopped: tr.stopped,
                 x: tr.x,
                 chart_switches: tr.chart_switches,
+                // a reduced model keeps the dependent set of its basis
+                partition_switches: vec![],
             },
             coordinates: tr.z,
             velocities: tr.zd,
