@@ -269,6 +269,48 @@ pub fn compute(
     Ok((curves?, segments))
 }
 
+/// The stored CalculiX solid reference of the whole flexure
+/// (`research/ch3/flexure.py`, `fixtures/curves/solid/`).
+pub const SOLID: &str = "fixtures/curves/solid/flexure_ch3_20x20x2.csv";
+
+/// One point of the solid reference: M (N m), ϕ (degrees), ω1 … (Hz).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolidPoint {
+    /// The moment.
+    pub m: f64,
+    /// The end's rotation.
+    pub phi: f64,
+    /// The frequencies in order.
+    pub freqs: Vec<f64>,
+}
+
+/// Reads the solid reference, sorted by M.
+pub fn read_solid(root: &Path) -> Result<Vec<SolidPoint>, String> {
+    use crate::solid6::read_solid_keyed;
+    let p = root.join(SOLID);
+    let by_m = read_solid_keyed(&p, "solid", &["M", "phi_deg"], 0)?;
+    let by_phi = read_solid_keyed(&p, "solid", &["M", "phi_deg"], 1)?;
+    if by_m.points.len() != by_phi.points.len() {
+        return Err(format!(
+            "{}: the moments and rotations do not pair up",
+            p.display()
+        ));
+    }
+    let mut v: Vec<SolidPoint> = by_m
+        .points
+        .into_iter()
+        .zip(by_phi.points)
+        .map(|((m, freqs), (phi, _))| SolidPoint { m, phi, freqs })
+        .collect();
+    v.sort_by(|a, b| a.m.total_cmp(&b.m));
+    Ok(v)
+}
+
+/// The point of a model's curve at moment `m` (N m), if the curve has it.
+pub fn at_moment(c: &[CurvePoint], m: f64) -> Option<&CurvePoint> {
+    c.iter().find(|p| (p.lambda * M_MAX - m).abs() < 1e-9)
+}
+
 /// Where the chapter's fixtures live.
 pub fn fixture_dir(root: &Path) -> std::path::PathBuf {
     root.join("fixtures/curves/ch3")

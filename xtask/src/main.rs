@@ -168,7 +168,7 @@ fn reproduce(
     }
     if matches!(ch, Chapter::Ch3 | Chapter::All) {
         let t = std::time::Instant::now();
-        xtask::reproduce3::reproduce(&out.join("ch3"), pg)?;
+        xtask::reproduce3::reproduce(root, &out.join("ch3"), pg)?;
         summary.push(format!(
             "chapter 3 in {:.0} s: {}",
             t.elapsed().as_secs_f64(),

@@ -38,23 +38,36 @@ pub struct SolidCurve {
 /// end in `x_S, S_y, S_z, mode, f_Hz`; the case column before them may hold
 /// commas.
 pub fn read_solid(path: &Path, label: &str) -> Result<SolidCurve, String> {
+    read_solid_keyed(path, label, &["x_S", "S_y", "S_z"], 0)
+}
+
+/// Reads a solid curve whose rows end in `columns…, mode, f_Hz` (after a
+/// case column that may hold commas), keyed by `columns[key]`.
+pub fn read_solid_keyed(
+    path: &Path,
+    label: &str,
+    columns: &[&str],
+    key: usize,
+) -> Result<SolidCurve, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut points: Vec<(f64, Vec<f64>)> = vec![];
+    let width = columns.len() + 2;
     for (i, line) in text.lines().enumerate().skip(1) {
         let c: Vec<&str> = line.split(',').map(str::trim).collect();
         let bad = || {
             format!(
-                "{}:{}: expected `…, x_S, S_y, S_z, mode, f_Hz`, found `{line}`",
+                "{}:{}: expected `…, {}, mode, f_Hz`, found `{line}`",
                 path.display(),
-                i + 1
+                i + 1,
+                columns.join(", ")
             )
         };
-        if c.len() < 5 {
+        if c.len() < width {
             return Err(bad());
         }
         let num = |s: &str| s.parse::<f64>().map_err(|_| bad());
         let (x, mode, f) = (
-            num(c[c.len() - 5])?,
+            num(c[c.len() - width + key])?,
             num(c[c.len() - 2])?,
             num(c[c.len() - 1])?,
         );
