@@ -126,7 +126,7 @@ impl Dynamics {
     /// Chooses the dependent set again at (t, q, q̇) if a better one exists
     /// ([`best_dependent_set`](Self::best_dependent_set), better as for the
     /// run's watch: [`PARTITION_IMPROVEMENT`] times the current set's
-    /// estimate and [`PARTITION_RECOVERY`] of `chosen`, the estimate the
+    /// estimate and `PARTITION_RECOVERY` of `chosen`, the estimate the
     /// current set had when it was chosen; 0 to require only the first):
     /// rebuilds the dynamics with it, its position solve starting from the
     /// current configuration, and returns q, q̇ in it (mapped through x,
