@@ -21,7 +21,6 @@
 
 use crate::{Dynamics, DynamicsError};
 use flexmb_model::{Mechanism, PartitionSwitch};
-use std::sync::Arc;
 
 /// q and q̇ in a new dependent set.
 type StateInSet = (Vec<f64>, Vec<f64>);
@@ -148,13 +147,7 @@ impl Dynamics {
             return Ok(None);
         };
         log.push(sw);
-        let x = self.kin.x().to_vec();
-        let mech = Arc::new(mech);
-        let (q1, qd1) = self.in_chart_of(&mech);
-        self.replace_mechanism(mech);
-        self.kin.set_guess(&x);
-        self.kinematics_at(t, &q1, None)?;
-        Ok(Some((q1, qd1)))
+        self.adopt(t, mech).map(Some)
     }
 }
 

@@ -987,17 +987,25 @@ impl Dynamics {
             return Ok(None);
         }
         self.kinematics_at(t, q, Some(qd))?;
-        let x = self.kin.x().to_vec();
         let mut mech = (*self.mech).clone();
         for (c, (slot, x_new_dep)) in wanted {
             log.push(mech.switch_chart(c, slot, x_new_dep, t));
         }
+        self.adopt(t, mech).map(Some)
+    }
+
+    /// Rebuilds this dynamics on `mech`, the same scene with other charts
+    /// or another dependent set, its position solve starting from the
+    /// current configuration (kinematics solved at t), and returns q, q̇ in
+    /// it, mapped through x, ẋ. Chart switches and re-partitioning share it.
+    pub(crate) fn adopt(&mut self, t: f64, mech: Mechanism) -> Result<(Q, Q), DynamicsError> {
+        let x = self.kin.x().to_vec();
         let mech = Arc::new(mech);
         let (q1, qd1) = self.in_chart_of(&mech);
         self.replace_mechanism(mech);
         self.kin.set_guess(&x);
         self.kinematics_at(t, &q1, None)?;
-        Ok(Some((q1, qd1)))
+        Ok((q1, qd1))
     }
 
     /// Puts this dynamics in the chart of `mech` (the same scene with other
