@@ -87,17 +87,8 @@ impl Kinematics {
     /// the nodal coordinates x_i that belong to ξ (k = ξ index of x_i): the
     /// nodal columns of the right-hand side B of (5.8a), up to sign.
     pub(crate) fn for_each_nodal_xi_entry(&self, mut visit: impl FnMut(usize, usize, f64)) {
-        for (ei, e) in self.mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
-            for (c, gi) in e.x_index.iter().enumerate() {
-                let Some(k) = self.xi_of_x[*gi] else { continue };
-                for (a, r) in m.rows.iter().enumerate() {
-                    if let Some(r) = r {
-                        visit(*r, k, jl[a * m.nx + c]);
-                    }
-                }
-            }
+        for e in &self.xi_entries {
+            visit(e.row, e.col, self.jac_local[e.element][e.local]);
         }
     }
 
