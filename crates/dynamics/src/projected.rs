@@ -158,17 +158,11 @@ impl Dynamics {
                 t,
             });
         }
-        // F,z column by column; ẋ = F,z ż (+ F,u u̇) with q̇ = V ż
-        for k in 0..v.ncols() {
-            let Some(col) = v.col(k).try_as_col_major() else {
-                return Err(DynamicsError::Invalid(
-                    "the directions V must be stored by columns (row stride 1)".into(),
-                ));
-            };
-            self.kin
-                .transfer_times(col.as_slice(), p.fz.col_as_slice_mut(k))
-                .map_err(kin_err)?;
-        }
+        // F,z = F,q V by one block solve (J factorized at x); ẋ = F,z ż
+        // (+ F,u u̇) with q̇ = V ż
+        self.kin
+            .transfer_matrix(v, p.fz.as_mut())
+            .map_err(kin_err)?;
         for (i, qd) in p.qd.iter_mut().enumerate() {
             *qd = (0..zd.len()).map(|k| v[(i, k)] * zd[k]).sum();
         }

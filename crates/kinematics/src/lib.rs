@@ -134,6 +134,9 @@ pub struct Kinematics {
     /// A direction of ξ (q̈ and ü, or a direction of q) for the solves
     /// along one.
     xi_dir: Vec<f64>,
+    /// The right-hand sides of a block of directions
+    /// ([`transfer_matrix`](Kinematics::transfer_matrix)).
+    block: Mat<f64>,
     xd: Vec<f64>,
     epsd: Vec<f64>,
     // acceleration level

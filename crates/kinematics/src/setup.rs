@@ -111,6 +111,7 @@ impl Kinematics {
             have_solution: false,
             xid: vec![0.0; n_xi],
             xi_dir: vec![0.0; n_xi],
+            block: Mat::zeros(0, 0),
             xd: vec![0.0; n_x],
             epsd: vec![0.0; n_eps],
             xdd0: vec![0.0; n_x],

@@ -143,26 +143,6 @@ impl Kinematics {
         }
     }
 
-    /// F,q v into `out` (n_x entries) for a direction `v` of the degrees of
-    /// freedom (n_q entries), without F,ξ: one solve of J y_dep = B (v, 0)
-    /// (thesis (5.8a) along v) with the factorization at hand, refined
-    /// against the exact J(x) as in [`velocities_refined`](Self::velocities_refined).
-    /// With the columns of a reduction basis G,z as v this gives F,z = F,q G,z
-    /// column by column (thesis (6.15)) at the cost of n_z solves instead of
-    /// the n_q + n_u of F,ξ.
-    pub fn transfer_times(&mut self, v: &[f64], out: &mut [f64]) -> Result<(), KinematicsError> {
-        self.check_lengths(&[
-            ("v", v.len(), self.n_q),
-            ("F,q v", out.len(), self.mech.n_x()),
-        ])?;
-        let mut dir = std::mem::take(&mut self.xi_dir);
-        dir[..self.n_q].copy_from_slice(v);
-        dir[self.n_q..].fill(0.0);
-        let solved = self.solve_direction(&dir, false, out);
-        self.xi_dir = dir;
-        solved
-    }
-
     /// Solves the constraint equations differentiated along the direction
     /// `dir` of ξ = (q, u), J y_dep = B dir (minus D_c,xx\[ẋ, ẋ\] on the
     /// constraint rows when `convective`, the second time derivative (5.8b)),

@@ -1,7 +1,11 @@
 //! One evaluation of the reduced equations of motion (6.15), z̈ from (z, ż),
-//! of MSI-2 of the 44-DOF spatial straight guidance (thesis §6.4, absolute
-//! nodal coordinates as DOFs, gravity; the basis from 300 equilibria along
-//! the stroke as in `cargo xtask reproduce ch6`). Target ≤ 25 µs.
+//! of the 44-DOF spatial straight guidance (thesis §6.4, gravity):
+//!
+//! * MSI-2 (absolute nodal coordinates as DOFs, a 33-row kinematic
+//!   Jacobian; the basis from 300 equilibria along the stroke as in `cargo
+//!   xtask reproduce ch6`). Target ≤ 25 µs.
+//! * MODAL-13 (deformation DOFs as the FBM models of ch6, a 77-row
+//!   Jacobian; the first 13 modes at rest, the size of SVD-13).
 //!
 //! "at one state" repeats the evaluation at a fixed (z, ż); "along a
 //! trajectory" evaluates, in their order, the 308 states an Adams run of
@@ -15,7 +19,9 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use flexmb_dynamics::Integrator;
 use flexmb_linearize::{sweep, SweepOptions, SweepParameter};
 use flexmb_model::{Component, DofChoice, Select};
-use flexmb_reduction::{interpolated_basis_from_sweep, ReducedModel, SubspaceInterpolation};
+use flexmb_reduction::{
+    interpolated_basis_from_sweep, modal_basis, ReducedModel, SubspaceInterpolation,
+};
 use std::sync::Arc;
 
 mod common;
@@ -57,6 +63,22 @@ fn guidance(c: &mut Criterion) {
     common::bench_model(
         c,
         "MSI-2, spatial guidance (n_q = 44, n_z = 2)",
+        &mut m,
+        &states,
+        true,
+    );
+    // MODAL-13 in deformation DOFs, the response to the pulse from rest
+    let mech = Arc::new(
+        common::scene("straight_guidance_spatial.ron")
+            .build(None)
+            .unwrap(),
+    );
+    let basis = modal_basis(&mech, 0.0, &mech.q0(), 13, None).unwrap();
+    let mut m = ReducedModel::new(mech, Box::new(basis)).unwrap();
+    let states = common::trajectory(&mut m, Integrator::Adams, (0.0, 0.02, 41), &[0.0; 13]);
+    common::bench_model(
+        c,
+        "MODAL-13, spatial guidance (n_q = 44, n_z = 13)",
         &mut m,
         &states,
         true,

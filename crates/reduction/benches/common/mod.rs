@@ -56,6 +56,9 @@ pub fn trajectory(
 /// The kinematic work per evaluation along `states` with each path (not
 /// timed): Newton iterations of the position solve, factorizations and
 /// refinement steps of J.
+// (not inlined: a profile can be split after each call with callgrind's
+// --dump-after)
+#[inline(never)]
 fn kinematic_work(model: &mut ReducedModel, states: &[(f64, Vec<f64>)], full_mass: bool) -> String {
     let n = model.n_z();
     let mut zdd = vec![0.0; n];
