@@ -105,8 +105,8 @@ impl Dynamics {
     /// # Errors
     ///
     /// [`DynamicsError::Invalid`] for slices of the wrong length (q and c
-    /// need n_q entries, V n_q rows, ż one per column of V) or a V whose
-    /// columns are not contiguous; [`DynamicsError::NonFinite`] for a
+    /// need n_q entries, V n_q rows, ż one per column of V);
+    /// [`DynamicsError::NonFinite`] for a
     /// non-finite ż; [`DynamicsError::Kinematics`] when the position solve
     /// or a solve with J fails.
     pub fn projected_mass_and_force(

@@ -53,6 +53,18 @@ pub fn trajectory(
     rec.states
 }
 
+/// z̈ of `model` at (t, y = (z, ż)): by the projected evaluation, or by
+/// the projection of the unreduced Mq if `full_mass`.
+fn evaluate(model: &mut ReducedModel, full_mass: bool, t: f64, y: &[f64], zdd: &mut [f64]) {
+    let n = model.n_z();
+    if full_mass {
+        model.accelerations_from_full_mass(t, &y[..n], &y[n..], zdd)
+    } else {
+        model.accelerations(t, &y[..n], &y[n..], zdd)
+    }
+    .unwrap()
+}
+
 /// The kinematic work per evaluation along `states` with each path (not
 /// timed): Newton iterations of the position solve, factorizations and
 /// refinement steps of J.
@@ -66,12 +78,7 @@ fn kinematic_work(model: &mut ReducedModel, states: &[(f64, Vec<f64>)], full_mas
     let (f0, r0) = (k.factorizations(), k.refinements());
     let mut iterations = 0;
     for (t, y) in states {
-        if full_mass {
-            model.accelerations_from_full_mass(*t, &y[..n], &y[n..], &mut zdd)
-        } else {
-            model.accelerations(*t, &y[..n], &y[n..], &mut zdd)
-        }
-        .unwrap();
+        evaluate(model, full_mass, *t, y, &mut zdd);
         iterations += model.dynamics().kinematics().iterations();
     }
     let k = model.dynamics().kinematics();
@@ -105,43 +112,24 @@ pub fn bench_model(
             kinematic_work(model, states, true)
         );
     }
-    let n = model.n_z();
-    let mut zdd = vec![0.0; n];
+    let mut zdd = vec![0.0; model.n_z()];
     let (t, y) = states[states.len() / 2].clone();
     let mut g = c.benchmark_group(group);
-    g.bench_function("z̈ at one state", |b| {
-        b.iter(|| {
-            model
-                .accelerations(t, black_box(&y[..n]), &y[n..], &mut zdd)
-                .unwrap()
-        })
-    });
-    let mut k = 0;
-    g.bench_function("z̈ along a trajectory", |b| {
-        b.iter(|| {
-            let (t, y) = &states[k % states.len()];
-            k += 1;
-            model
-                .accelerations(*t, black_box(&y[..n]), &y[n..], &mut zdd)
-                .unwrap()
-        })
-    });
-    if full_mass {
-        g.bench_function("z̈ by the full mass at one state", |b| {
-            b.iter(|| {
-                model
-                    .accelerations_from_full_mass(t, black_box(&y[..n]), &y[n..], &mut zdd)
-                    .unwrap()
-            })
+    let paths: &[(&str, bool)] = if full_mass {
+        &[("", false), ("by the full mass ", true)]
+    } else {
+        &[("", false)]
+    };
+    for &(label, full) in paths {
+        g.bench_function(format!("z̈ {label}at one state"), |b| {
+            b.iter(|| evaluate(model, full, t, black_box(&y), &mut zdd))
         });
         let mut k = 0;
-        g.bench_function("z̈ by the full mass along a trajectory", |b| {
+        g.bench_function(format!("z̈ {label}along a trajectory"), |b| {
             b.iter(|| {
                 let (t, y) = &states[k % states.len()];
                 k += 1;
-                model
-                    .accelerations_from_full_mass(*t, black_box(&y[..n]), &y[n..], &mut zdd)
-                    .unwrap()
+                evaluate(model, full, *t, black_box(y), &mut zdd)
             })
         });
     }
