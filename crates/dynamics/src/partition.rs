@@ -75,7 +75,20 @@ impl Dynamics {
     /// square regular block over the candidates (a picked column is at the
     /// rounding level of the largest).
     pub fn best_dependent_set(&self) -> Option<(Vec<usize>, f64)> {
-        let eligible = self.mech.partition_eligible();
+        self.best_dependent_set_keeping(&[])
+    }
+
+    /// [`best_dependent_set`](Self::best_dependent_set) with the
+    /// coordinates of the DOF slots `keep` kept as DOFs (the held DOFs of a
+    /// static solve: a held value must keep its meaning).
+    fn best_dependent_set_keeping(&self, keep: &[usize]) -> Option<(Vec<usize>, f64)> {
+        let kept = self.kept_coordinates(keep);
+        let eligible: Vec<usize> = self
+            .mech
+            .partition_eligible()
+            .into_iter()
+            .filter(|i| !kept.contains(i))
+            .collect();
         let forced: Vec<usize> = self
             .mech
             .dependent
@@ -84,6 +97,16 @@ impl Dynamics {
             .filter(|i| !eligible.contains(i))
             .collect();
         self.pivoted_picks(&forced, &eligible)
+    }
+
+    /// The nodal coordinates in the DOF slots `keep`.
+    fn kept_coordinates(&self, keep: &[usize]) -> Vec<usize> {
+        keep.iter()
+            .filter_map(|s| match self.mech.dofs.get(*s) {
+                Some(flexmb_model::Coordinate::Node(i)) => Some(*i),
+                _ => None,
+            })
+            .collect()
     }
 
     /// The same estimate for the current dependent set.
@@ -107,12 +130,13 @@ impl Dynamics {
         Some((picks.into_iter().map(|c| cols[c]).collect(), r_min))
     }
 
-    /// [`best_dependent_set`](Self::best_dependent_set) if it is another
+    /// [`best_dependent_set`](Self::best_dependent_set), with the
+    /// coordinates of the DOF slots `keep` kept as DOFs, if it is another
     /// set than the current one, [`PARTITION_IMPROVEMENT`] times better
     /// conditioned, and at least [`PARTITION_RECOVERY`] times as well as
     /// `chosen` (the current set's estimate when it was chosen).
-    pub(crate) fn better_dependent_set(&self, chosen: f64) -> Option<Vec<usize>> {
-        let (mut best, r_best) = self.best_dependent_set()?;
+    pub(crate) fn better_dependent_set(&self, chosen: f64, keep: &[usize]) -> Option<Vec<usize>> {
+        let (mut best, r_best) = self.best_dependent_set_keeping(keep)?;
         best.sort_unstable();
         let mut now = self.mech.dependent.clone();
         now.sort_unstable();
@@ -126,20 +150,23 @@ impl Dynamics {
     /// ([`best_dependent_set`](Self::best_dependent_set), better as for the
     /// run's watch: [`PARTITION_IMPROVEMENT`] times the current set's
     /// estimate and `PARTITION_RECOVERY` of `chosen`, the estimate the
-    /// current set had when it was chosen; 0 to require only the first):
-    /// rebuilds the dynamics with it, its position solve starting from the
-    /// current configuration, and returns q, q̇ in it (mapped through x,
-    /// ẋ). `None` if the set stays. The switch is appended to `log`.
+    /// current set had when it was chosen; 0 to require only the first),
+    /// the coordinates of the DOF slots `keep` staying DOFs (the held DOFs
+    /// of a static solve): rebuilds the dynamics with it, its position
+    /// solve starting from the current configuration, and returns q, q̇ in
+    /// it (mapped through x, ẋ). `None` if the set stays. The switch is
+    /// appended to `log`.
     pub fn switch_partition(
         &mut self,
         t: f64,
         q: &[f64],
         qd: &[f64],
         chosen: f64,
+        keep: &[usize],
         log: &mut Vec<PartitionSwitch>,
     ) -> Result<Option<StateInSet>, DynamicsError> {
         self.kinematics_at(t, q, Some(qd))?;
-        let Some(best) = self.better_dependent_set(chosen) else {
+        let Some(best) = self.better_dependent_set(chosen, keep) else {
             return Ok(None);
         };
         let mut mech = (*self.mech).clone();
