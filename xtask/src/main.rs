@@ -45,6 +45,14 @@ enum Cmd {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
+    /// Build the chapter-4 mechanism's part superelements from their FE
+    /// models and write them with its scene and skeletons to
+    /// fixtures/scenes (two_dof_mechanism.ron, two_dof_mechanism/*.se.ron).
+    Mechanism4 {
+        /// Write into this directory instead of fixtures/scenes.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Recompute the eigenfrequency curves and compare them with fixtures/curves.
     Regress {
         /// Store the recomputed curves as the new fixtures instead of comparing.
@@ -106,6 +114,7 @@ fn main() -> ExitCode {
             };
             reproduce(&root, &out, chapter, &pg)
         }
+        Cmd::Mechanism4 { out } => mechanism4(out.unwrap_or_else(xtask::ch4::fixture_dir)),
         Cmd::Regress { update, chapter } => {
             regress(&root, update, chapter.unwrap_or(Chapter::All), &pg)
         }
@@ -147,6 +156,24 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn mechanism4(dir: PathBuf) -> Result<(), String> {
+    let t = std::time::Instant::now();
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let builds = xtask::ch4::write_model(&dir, &|name| eprintln!("  built {name}"))?;
+    for b in &builds {
+        println!(
+            "{:<48} {:>6} elements {:>8.4} kg {:>6.1} s  {}",
+            b.what, b.elements, b.mass, b.seconds, b.file
+        );
+    }
+    println!(
+        "wrote {} and its skeletons in {:.0} s",
+        dir.join(xtask::ch4::SCENE_FILE).display(),
+        t.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 fn reproduce(
