@@ -18,6 +18,7 @@ pub mod progress;
 pub mod regress;
 pub mod report;
 pub mod reproduce3;
+pub mod reproduce4;
 pub mod reproduce6;
 pub mod solid6;
 

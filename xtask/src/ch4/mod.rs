@@ -9,6 +9,7 @@ pub mod layout;
 pub mod parts;
 pub mod path;
 pub mod scene;
+pub mod sweep;
 
 use layout::{HingeKind, Layout, Member};
 use rayon::prelude::*;
@@ -101,8 +102,14 @@ pub fn write_model(dir: &Path, progress: &(dyn Fn(&str) + Sync)) -> Result<Vec<P
         std::fs::write(dir.join(name), text).map_err(|e| format!("{name}: {e}"))
     };
     write(SCENE_FILE, scene::full_scene(&layout))?;
-    write(SKELETON_FILE, scene::skeleton(&layout, true))?;
-    write(SKELETON_RIGID_FILE, scene::skeleton(&layout, false))?;
+    write(
+        SKELETON_FILE,
+        scene::skeleton(&layout, scene::Releases::ALL),
+    )?;
+    write(
+        SKELETON_RIGID_FILE,
+        scene::skeleton(&layout, scene::Releases::NONE),
+    )?;
     Ok(builds)
 }
 
