@@ -110,6 +110,25 @@ pub struct Ch4Results {
     pub without_gq: Vec<Vec<f64>>,
     /// Sizes: nodal coordinates, deformations, DOFs, elements.
     pub sizes: [usize; 4],
+    /// MAC tracking of the first [`TRACKED`] modes along the path.
+    pub tracking: flexmb_linearize::Tracking,
+}
+
+/// Modes tracked by MAC along the path: the eight plotted and two more,
+/// which modes from above can cross into.
+pub const TRACKED: usize = 10;
+
+/// The tracks of the modes: per track, its frequency at each point.
+pub fn tracked_frequencies(r: &Ch4Results) -> Vec<Vec<f64>> {
+    (0..TRACKED)
+        .map(|t| {
+            r.points
+                .iter()
+                .zip(&r.tracking.perms)
+                .map(|(p, perm)| p.frequencies_hz[perm[t]])
+                .collect()
+        })
+        .collect()
 }
 
 /// Runs the sweep and its analyses on the committed model.
@@ -129,12 +148,26 @@ pub fn compute(root: &Path, o: &Ch4Options, pg: &Progress) -> Result<Ch4Results,
         .map(|p| sweep::features(&mech, p))
         .collect::<Result<Vec<_>, String>>()?;
     let without_gq = sweep::without_gq(&mech, &points, PLOTTED)?;
+    // MAC with the mass of each point, over the first TRACKED shapes
+    let sets: Vec<faer::Mat<f64>> = points
+        .iter()
+        .map(|p| {
+            let v = p.modes.as_ref().expect("kept");
+            v.subcols(0, TRACKED.min(v.ncols())).to_owned()
+        })
+        .collect();
+    let masses: Vec<faer::Mat<f64>> = points
+        .iter()
+        .map(|p| p.mass.clone().expect("kept"))
+        .collect();
+    let tracking = flexmb_linearize::track_modes(&sets, Some(&masses));
     Ok(Ch4Results {
         points,
         sweep_seconds,
         features,
         without_gq,
         sizes: [mech.n_x(), mech.n_eps(), mech.n_dof(), mech.elements.len()],
+        tracking,
     })
 }
 
@@ -150,6 +183,8 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
         .map_err(io)?;
     let mut figs = Figures::default();
     figures(&r, out, &mut figs).map_err(io)?;
+    let (mech, _) = sweep::mechanism(&fixture_scene(root))?;
+    pictures(&mech, &r, out, &mut figs).map_err(io)?;
     let diagnosis = constraint_summary(root)?;
     let wall = start.elapsed().as_secs_f64();
     let md = report(&o, &r, &figs, &diagnosis, wall);
@@ -194,6 +229,17 @@ fn figures(r: &Ch4Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
     let top = column(PLOTTED - 1).iter().fold(0.0f64, |m, v| m.max(*v));
     marks(&mut p, 0.0, top);
     figs.save(&p, out, "fig4_16_omega3_8")?;
+    // the modes followed by MAC, named by their shape at s = 0
+    let mut p = Plot::new(
+        "Modes tracked by MAC along the path, named by their shape at s = 0",
+        "arc length s along the path (4.1) (m)",
+        "eigenfrequency (Hz)",
+    );
+    for (t, f) in tracked_frequencies(r).iter().enumerate().skip(2) {
+        let label = r.features[0][r.tracking.perms[0][t]].label();
+        p.push(Series::line(&format!("track {} ({label})", t + 1), &s, f));
+    }
+    figs.save(&p, out, "tracked_modes")?;
     // the effect of G_q
     let mut p = Plot::new(
         "Eigenfrequencies with and without G_q",
@@ -210,6 +256,71 @@ fn figures(r: &Ch4Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
         p.push(Series::dashed(&format!("ω{} without", k + 1), &s, &w));
     }
     figs.save(&p, out, "gq_effect")?;
+    Ok(())
+}
+
+/// The sweep point nearest the second mark of the path (a quarter turn on
+/// the circle: the end-effector 50 mm from its rest position along +y).
+fn deflected_point(r: &Ch4Results) -> usize {
+    let m = Path4::new().marks()[1];
+    r.points
+        .iter()
+        .enumerate()
+        .min_by(|a, b| (a.1.s - m).abs().total_cmp(&(b.1.s - m).abs()))
+        .map(|(i, _)| i)
+        .unwrap_or(0)
+}
+
+/// The mechanism at rest and deflected (reference overlaid), and modes 3
+/// and 4 there (issue 23), drawn by `flexmb_draw` from the sweep's own
+/// configurations.
+fn pictures(
+    mech: &std::sync::Arc<flexmb_model::Mechanism>,
+    r: &Ch4Results,
+    out: &Path,
+    figs: &mut Figures,
+) -> std::io::Result<()> {
+    use flexmb_draw::{Configuration, DrawOptions, View};
+    let at = |i: usize| Configuration {
+        mechanism: mech.clone(),
+        q: r.points[i].q.clone(),
+        x: r.points[i].x.clone(),
+        t: 0.0,
+        load_scale: 1.0,
+    };
+    let d = deflected_point(r);
+    crate::pictures::save(
+        figs,
+        out,
+        "mech_deflected",
+        &at(d),
+        &DrawOptions {
+            view: Some(View::Xy),
+            reference: true,
+            title: Some(format!(
+                "The mechanism at s = {:.4} m (end-effector 50 mm along +y), the reference lighter",
+                r.points[d].s
+            )),
+            ..Default::default()
+        },
+    )?;
+    for k in [3, 4] {
+        for (i, tag, name) in [(0, "rest", "at rest"), (d, "deflected", "deflected")] {
+            crate::pictures::save(
+                figs,
+                out,
+                &format!("mech_mode{k}_{tag}"),
+                &at(i),
+                &DrawOptions {
+                    view: Some(View::Iso),
+                    mode: Some(k),
+                    phases: Some(2),
+                    title: Some(format!("Mode {k} {name}")),
+                    ..Default::default()
+                },
+            )?;
+        }
+    }
     Ok(())
 }
 
@@ -348,6 +459,14 @@ fn report(
         below.iter().max().unwrap_or(&0)
     );
     s += &figs.markdown(|f| f.starts_with("fig4"));
+    let _ = writeln!(
+        s,
+        "## The mechanism and its modes\n\nDrawn by `flexmb_draw` (as `flexmb draw`) from \
+         the sweep's own configurations: members as chords between their boundary nodes, \
+         sheets as thin boxes of their section; modes 3 (the CrossBar's twist at rest) and \
+         4 (the first out-of-plane mode) at rest and deflected, two phases each.\n"
+    );
+    s += &figs.markdown(|f| f.starts_with("mech_"));
     let mut t = Table::new(&[
         "mode",
         "at s = 0 (Hz)",
@@ -390,6 +509,43 @@ fn report(
         t.row(vec![sig(r.points[i].s), labels.join("; ")]);
     }
     let _ = writeln!(s, "{}", t.render());
+    let tracks = tracked_frequencies(r);
+    let mut t = Table::new(&[
+        "track",
+        "shape at s = 0",
+        "shape at the end of the path",
+        "at s = 0 (Hz)",
+        "min along the path",
+        "lowest MAC with the previous point",
+    ]);
+    let last = r.points.len() - 1;
+    for (k, f) in tracks.iter().enumerate() {
+        let col0 = r.tracking.perms[0][k];
+        let col1 = r.tracking.perms[last][k];
+        let conf = r
+            .tracking
+            .confidence
+            .iter()
+            .map(|c| c[k])
+            .fold(1.0, f64::min);
+        t.row(vec![
+            (k + 1).to_string(),
+            r.features[0][col0].label(),
+            r.features[last][col1].label(),
+            sig(f[0]),
+            sig(f.iter().fold(f64::INFINITY, |m, v| m.min(*v))),
+            sig(conf),
+        ]);
+    }
+    let _ = writeln!(
+        s,
+        "Followed by MAC (mass-weighted, the first {TRACKED} modes, an assignment per \
+         step that maximizes the summed MAC with the previous point), the modes keep their \
+         shapes along the path while the sorted frequencies change places where they \
+         cross:\n\n{}",
+        t.render()
+    );
+    s += &figs.markdown(|f| f == "tracked_modes");
     let _ = writeln!(s, "## The thesis's claims\n");
     let (_, _, v1) = variation(r, 0);
     let (_, _, v2) = variation(r, 1);
