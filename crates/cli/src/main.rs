@@ -20,6 +20,7 @@ mod path;
 mod reduce;
 mod reduced;
 mod report;
+mod superelement;
 mod vtk_out;
 
 use clap::{Args, Parser, Subcommand};
@@ -44,7 +45,7 @@ use std::sync::Arc;
     version,
     about = "Flexible multibody dynamics and model reduction for compliant mechanisms",
     long_about = "Flexible multibody dynamics and model reduction for compliant mechanisms.\n\nScenes are RON files (see docs/scene-format.md); examples are in fixtures/scenes/.",
-    after_help = "Examples:\n  flexmb info fixtures/scenes/straight_guidance_spatial.ron\n  flexmb static fixtures/scenes/straight_guidance_spatial.ron --out results/static\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --t-end 0.5 --out results/sim\n  flexmb simulate fixtures/scenes/spin_up_planar.ron --t-end 20 --integrator adams --rtol 1e-6\n  flexmb reduce fixtures/scenes/straight_guidance_planar.ron --method modal --modes 3 --out modal3.ron\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --reduced modal3.ron --t-end 0.5\n  flexmb build-superelement spec.ron"
+    after_help = "Examples:\n  flexmb info fixtures/scenes/straight_guidance_spatial.ron\n  flexmb static fixtures/scenes/straight_guidance_spatial.ron --out results/static\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --t-end 0.5 --out results/sim\n  flexmb simulate fixtures/scenes/spin_up_planar.ron --t-end 20 --integrator adams --rtol 1e-6\n  flexmb reduce fixtures/scenes/straight_guidance_planar.ron --method modal --modes 3 --out modal3.ron\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --reduced modal3.ron --t-end 0.5\n  flexmb build-superelement spec.ron\n  flexmb build-superelement --mesh part.geo --material steel --interface p=left --interface q=plane:x=0.1 --out results/part"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -123,11 +124,10 @@ enum Command {
     /// Draw the mechanism (reference, static equilibrium or a state) and its
     /// mode shapes as SVG or PNG (see docs/cli.md).
     Draw(draw::DrawArgs),
-    /// Build a linear superelement from FE matrices (see crates/superelement/README.md).
-    BuildSuperelement {
-        /// Specification file (RON).
-        spec: PathBuf,
-    },
+    /// Build a linear superelement: from FE matrices named in a spec file
+    /// (see crates/superelement/README.md), or in one command from a mesh
+    /// (--mesh, see docs/superelement.md).
+    BuildSuperelement(superelement::SuperelementArgs),
 }
 
 /// Options of `flexmb simulate`.
@@ -336,7 +336,7 @@ fn run(command: Command) -> Result<(), Failure> {
         Command::Sweep(a) => sweep(&a),
         Command::Reduce(a) => reduce::reduce(&a),
         Command::Draw(a) => draw::draw(&a),
-        Command::BuildSuperelement { spec } => build_superelement(&spec),
+        Command::BuildSuperelement(a) => superelement::build_superelement(&a),
     }
 }
 
@@ -922,25 +922,4 @@ fn sweep_command_line(a: &SweepArgs) -> String {
         a.n,
         a.t_load
     )
-}
-
-fn build_superelement(spec_path: &Path) -> Result<(), Failure> {
-    let spec =
-        flexmb_superelement::Spec::read(spec_path).map_err(|e| Failure::Input(e.to_string()))?;
-    let base = spec_path.parent().unwrap_or(Path::new("."));
-    // errors in the input files (unreadable, truncated, mismatched K and M,
-    // a model that cannot be reduced) are input errors, exit code 2; a
-    // failed solver or write is exit code 1
-    let out = flexmb_superelement::build_from_spec(&spec, base).map_err(|e| {
-        if e.is_input() {
-            Failure::Input(e.to_string())
-        } else {
-            Failure::Compute(e.to_string())
-        }
-    })?;
-    say!("{}", out.result.summary(&spec.name).trim_end());
-    for f in &out.written {
-        say!("wrote {}", f.display());
-    }
-    Ok(())
 }

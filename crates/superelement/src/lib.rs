@@ -58,8 +58,11 @@ pub mod ansys;
 mod builder;
 pub mod consistency;
 mod error;
+pub mod from_mesh;
 pub mod geometry;
 pub mod harwell_boeing;
+pub mod interface;
+pub mod mesh_file;
 mod model;
 pub mod parts;
 pub mod readers;
@@ -78,5 +81,6 @@ pub use builder::{
     InterfacePattern, PointMass, RigidBodyProperties, RigidMotion, VE_INDEX,
 };
 pub use error::Error;
-pub use model::{DofMap, FeModel, NodeSelection, ReferenceMass, SolidElements, Sources};
-pub use spec::{build_from_spec, BuildOutput, ModelSource, Spec};
+pub use mesh_file::{MeshFile, MeshMaterial};
+pub use model::{DofMap, FeModel, NodeSelection, NodeSet, ReferenceMass, SolidElements, Sources};
+pub use spec::{build_from_spec, build_loaded, BuildOutput, FeSolver, ModelSource, Spec};

@@ -136,6 +136,22 @@ pub struct SolidElements {
     pub couplings: Vec<String>,
 }
 
+/// A named set of nodes of a model: a gmsh physical group (surface, curve,
+/// point) or an Abaqus/CalculiX *NSET, for interfaces by name
+/// ([`NodeSelection::Set`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NodeSet {
+    /// Its name (a gmsh physical group without a name is called by its
+    /// tag, e.g. "7").
+    pub name: String,
+    /// What it is, for messages: "physical surface", "node set", ….
+    pub what: String,
+    /// The gmsh physical tag, if it is a physical group.
+    pub tag: Option<i64>,
+    /// Node indices into the model, sorted.
+    pub nodes: Vec<usize>,
+}
+
 /// A mass the part must have (from a given volume and density).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReferenceMass {
@@ -165,6 +181,8 @@ pub struct FeModel {
     /// A mass the part must have, if known without elements (Matrix Market
     /// input with a volume and a density).
     pub reference_mass: Option<ReferenceMass>,
+    /// Named node sets (gmsh physical groups, *NSET of a deck).
+    pub node_sets: Vec<NodeSet>,
 }
 
 impl FeModel {
@@ -236,6 +254,7 @@ impl FeModel {
             sources: Sources::default(),
             solid: None,
             reference_mass: None,
+            node_sets: Vec::new(),
         })
     }
 
@@ -294,6 +313,41 @@ impl FeModel {
     /// The index of the node with label `id`.
     pub fn node_index(&self, id: u64) -> Option<usize> {
         self.index_of.get(&id).copied()
+    }
+    /// The node set called `name` (a gmsh physical group by name or by
+    /// tag, an *NSET; case-insensitive); an error listing the sets there are
+    /// when there is none of that name.
+    pub fn node_set(&self, name: &str) -> Result<&NodeSet, Error> {
+        let by_name = self.node_sets.iter().find(|s| s.name == name).or_else(|| {
+            self.node_sets
+                .iter()
+                .find(|s| s.name.eq_ignore_ascii_case(name))
+        });
+        let by_tag = || {
+            let t: i64 = name.trim().parse().ok()?;
+            // a surface first: interfaces are surfaces
+            self.node_sets
+                .iter()
+                .filter(|s| s.tag == Some(t))
+                .min_by_key(|s| !s.what.contains("surface"))
+        };
+        by_name.or_else(by_tag).ok_or_else(|| {
+            let there = if self.node_sets.is_empty() {
+                "it has no named node sets (a gmsh mesh has them for its physical groups, a deck for its *NSET)"
+                    .to_string()
+            } else {
+                let names: Vec<String> = self.node_sets.iter().map(NodeSet::describe).collect();
+                let names_only: Vec<&str> = self.node_sets.iter().map(|s| s.name.as_str()).collect();
+                let hint = flexmb_input::nearest(name, names_only.iter())
+                    .map(|n| format!(" (did you mean '{n}'?)"))
+                    .unwrap_or_default();
+                format!("it has {}{hint}", names.join(", "))
+            };
+            Error::Selection(format!(
+                "model {} has no node set '{name}': {there}",
+                self.name
+            ))
+        })
     }
     /// The DOF map.
     pub fn dofs(&self) -> &DofMap {
@@ -533,10 +587,30 @@ pub enum NodeSelection {
         /// Radius (m).
         radius: f64,
     },
+    /// The nodes of a named node set of the model ([`FeModel::node_sets`]:
+    /// a gmsh physical surface, curve or point group by name or tag, an
+    /// *NSET of a deck; names compared without regard to case).
+    Set(String),
     /// Nodes in any of the selections.
     Union(Vec<NodeSelection>),
     /// Nodes in all of the selections.
     Intersection(Vec<NodeSelection>),
+}
+
+impl NodeSet {
+    /// "physical surface 'left' (tag 2, 25 nodes)".
+    pub fn describe(&self) -> String {
+        let tag = match self.tag {
+            Some(t) if t.to_string() != self.name => format!("tag {t}, "),
+            _ => String::new(),
+        };
+        format!(
+            "{} '{}' ({tag}{} nodes)",
+            self.what,
+            self.name,
+            self.nodes.len()
+        )
+    }
 }
 
 impl NodeSelection {
@@ -582,6 +656,7 @@ impl NodeSelection {
                     .filter(|&i| (dot(sub(c[i], *point), *normal) / nn).abs() <= *tolerance)
                     .collect()
             }
+            NodeSelection::Set(name) => model.node_set(name)?.nodes.clone(),
             NodeSelection::InBox { min, max } => all()
                 .filter(|&i| (0..3).all(|d| c[i][d] >= min[d] && c[i][d] <= max[d]))
                 .collect(),
