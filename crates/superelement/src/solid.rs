@@ -107,8 +107,10 @@ pub fn solid_matrices(
 /// centroid on the 4-node one, the 3-point triangle rule (1/6, 1/6, 2/3)
 /// × 3 Gauss points on the 15-node wedge and the centroid × 2 Gauss points
 /// on the 6-node one. The mass takes the same rule (so does CalculiX),
-/// except on the 4-node tetrahedron, whose one point would lose the
-/// rigid-body inertia: there the 4-point rule (exact for its mass).
+/// except on the 4-node tetrahedron and the 6-node wedge, whose one point
+/// in the triangle would lose the rigid-body inertia even of an undistorted
+/// element: there the 4-point rule and the 3-point triangle rule × 2 Gauss
+/// points (exact for the mass of affine elements, as the other rules are).
 pub fn stiffness_rule(kind: SolidKind) -> Vec<([f64; 3], f64)> {
     let g2 = 1.0 / 3f64.sqrt();
     let g3 = (0.6f64).sqrt();
@@ -170,6 +172,18 @@ fn tet4_point_rule() -> Vec<([f64; 3], f64)> {
 fn mass_rule(kind: SolidKind) -> Vec<([f64; 3], f64)> {
     match kind {
         SolidKind::Tet4 => tet4_point_rule(),
+        SolidKind::Wedge6 => {
+            let g2 = 1.0 / 3f64.sqrt();
+            let tri3 = [
+                [1.0 / 6.0, 1.0 / 6.0],
+                [2.0 / 3.0, 1.0 / 6.0],
+                [1.0 / 6.0, 2.0 / 3.0],
+            ];
+            [-g2, g2]
+                .iter()
+                .flat_map(|&c| tri3.map(|p| ([p[0], p[1], c], 1.0 / 6.0)))
+                .collect()
+        }
         k => stiffness_rule(k),
     }
 }
