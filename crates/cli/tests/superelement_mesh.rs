@@ -18,18 +18,17 @@ use std::process::{Command, Output};
 
 const L: f64 = 0.1;
 
-/// A 0.1 × 0.01 × 0.006 m bar along x (a section that is not square, so
+/// The worked example of docs/superelement.md, `fixtures/meshes/bar.geo`:
+/// a 0.1 × 0.01 × 0.006 m bar along x (a section that is not square, so
 /// that the bending modes are apart and the normal modes come out alike
 /// from both solvers) with physical surfaces at its ends ("left" at x = 0,
 /// "right" at x = L, tag 3) and one side (tag 7).
-const BAR_GEO: &str = r#"SetFactory("OpenCASCADE");
-Box(1) = {0, -0.005, -0.003, 0.1, 0.01, 0.006};
-Mesh.CharacteristicLengthMax = 0.005;
-Physical Volume("BAR") = {1};
-Physical Surface("left") = {1};
-Physical Surface("right") = {2};
-Physical Surface(7) = {3};
-"#;
+fn bar_geo() -> String {
+    std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/meshes/bar.geo"),
+    )
+    .unwrap()
+}
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = common::temp_dir("semesh", name);
@@ -112,7 +111,7 @@ fn scaled_difference(a: &[Vec<f64>], b: &[Vec<f64>], first: usize) -> f64 {
 /// elements, which ccx refuses (the same mesh: physical groups do not
 /// change the meshing).
 fn spec_route(dir: &Path) -> flexmb_element::LinearSuperelement {
-    let volume_only: String = BAR_GEO
+    let volume_only: String = bar_geo()
         .lines()
         .filter(|l| !l.starts_with("Physical Surface"))
         .map(|l| format!("{l}\n"))
@@ -174,7 +173,7 @@ fn report_frequencies(report: &str) -> Vec<f64> {
 #[test]
 fn one_command_from_a_geo_equals_the_spec_route_and_its_stub_loads() {
     let dir = temp_dir("e2e");
-    std::fs::write(dir.join("bar.geo"), BAR_GEO).unwrap();
+    std::fs::write(dir.join("bar.geo"), bar_geo()).unwrap();
     let hand = spec_route(&dir);
     // the one command: built-in FE with the interfaces by name and by tag,
     // CalculiX with q on a plane
@@ -349,7 +348,7 @@ fn slanted_geo(deg: f64) -> String {
 #[test]
 fn wrong_input_is_refused_with_exit_code_2_naming_the_culprit() {
     let dir = temp_dir("wrong");
-    std::fs::write(dir.join("bar.geo"), BAR_GEO).unwrap();
+    std::fs::write(dir.join("bar.geo"), bar_geo()).unwrap();
     let mesh = |p: &str, q: &str| -> Vec<String> {
         [
             "--mesh",
@@ -402,7 +401,7 @@ fn wrong_input_is_refused_with_exit_code_2_naming_the_culprit() {
         &["interface q", "physical volume 'BAR'", "is a volume"],
     );
     // a .geo without a physical volume
-    let no_volume: String = BAR_GEO
+    let no_volume: String = bar_geo()
         .lines()
         .filter(|l| !l.starts_with("Physical Volume"))
         .map(|l| format!("{l}\n"))
@@ -638,5 +637,57 @@ fn wrong_input_is_refused_with_exit_code_2_naming_the_culprit() {
         stderr(&o)
     );
     assert!(stdout(&o).contains("## Warnings"), "{}", stdout(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The worked example on a shared export (docs/superelement.md): the
+/// Abaqus C3D10 block of `fixtures/fe-exports` in one command, the built-in
+/// FE on the deck's mesh with the interfaces on the end planes, against the
+/// spec route on the matrices Abaqus exported (`block_abaqus.spec.ron`):
+/// p and q at the end faces' centres, the same S̄ (both integrate C3D10's
+/// stiffness at 4 points) and the same rigid body.
+#[test]
+fn the_abaqus_block_in_one_command_equals_the_spec_route_on_abaqus_matrices() {
+    let fx = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/fe-exports");
+    let o = flexmb()
+        .arg("build-superelement")
+        .arg(fx.join("block_abaqus.spec.ron"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let abaqus = read_ron(&fx.join("../../target/fe-exports/block_abaqus.se.ron")).unwrap();
+    let dir = temp_dir("block");
+    let deck = fx.join("abaqus/blockC3D10.inp");
+    let o = build(
+        &dir,
+        &[
+            "--mesh",
+            deck.to_str().unwrap(),
+            "--material",
+            "E=2e11,nu=0.3,rho=2900",
+            "--interface",
+            "p=plane:x=0",
+            "--interface",
+            "q=plane:x=4",
+            "--out",
+            "block",
+        ],
+    );
+    let text = stdout(&o);
+    assert!(o.status.success(), "{}\n{text}", stderr(&o));
+    for part in [
+        "(257 nodes: 122 Tet10)",
+        "| p | the plane x = 0 (",
+        "(0.000000e0, 5.000000e-1, 5.000000e-1)",
+        "(4.000000e0, 5.000000e-1, 5.000000e-1)",
+        "From M̄: mass 1.160000e4 kg",
+    ] {
+        assert!(text.contains(part), "no '{part}' in\n{text}");
+    }
+    let own = read_ron(&dir.join("block/blockC3D10.se.ron")).unwrap();
+    assert_eq!(own.l0, 4.0);
+    let ds = scaled_difference(&abaqus.s_bar, &own.s_bar, 6);
+    println!("S̄ from Abaqus's matrices and from the built-in FE: {ds:.1e}");
+    assert!(ds < 1e-10, "S̄ differs by {ds:e}");
     let _ = std::fs::remove_dir_all(&dir);
 }

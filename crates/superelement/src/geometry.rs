@@ -452,8 +452,8 @@ fn face_shape(n: usize, p: [f64; 2]) -> Option<Vec<D>> {
     })
 }
 
-/// The area of a face with node positions `x` (3, 4, 6 or 8 nodes, see
-/// [`face_shape`]) and its first moment ∫ x dA, over its isoparametric
+/// The area of a face with node positions `x` (3, 4, 6 or 8 nodes, in the
+/// order of `flexmb_element::fe_faces`) and its first moment ∫ x dA, over its isoparametric
 /// geometry (4 × 4 Gauss points, on the collapsed coordinates of the
 /// triangle: exact for flat faces with straight edges). `None` for another
 /// node count.

@@ -25,7 +25,12 @@
 //!   the DOF mapping and nodal coordinates): the exports of the commercial
 //!   packages, with [`units`] for exports not in SI;
 //! * [`spec`]: a RON specification and [`build_from_spec`], the function behind
-//!   `flexmb build-superelement SPEC.ron`.
+//!   `flexmb build-superelement SPEC.ron`;
+//! * [`mesh_file`]: gmsh `.msh`/`.geo` and `.inp` meshes for the built-in FE
+//!   (now every solid kind, [`solid::SolidMesh`]) or a CalculiX run;
+//!   [`interface`]: where an interface lies (centroid, plane, the check of
+//!   warping modes); [`from_mesh`]: one command from a mesh to a
+//!   superelement (`flexmb build-superelement --mesh`).
 //!
 //! The sparse Cholesky factorization, the shift-invert eigensolver and the
 //! dense generalized eigensolver are those of `flexmb-linalg`
