@@ -84,10 +84,9 @@ enum Command {
         /// this directory.
         #[arg(long, value_name = "DIR")]
         vtk: Option<PathBuf>,
-        /// With --vtk: draw superelements as the chord between their nodes,
-        /// not as their FE mesh (smaller files for large meshes).
-        #[arg(long, requires = "vtk")]
-        vtk_chords: bool,
+        /// How --vtk draws superelements and beams.
+        #[command(flatten)]
+        vtk_style: vtk_out::VtkStyle,
     },
     /// Time response from the reference configuration (or from equilibrium with --static-first).
     Simulate(SimulateArgs),
@@ -110,10 +109,9 @@ enum Command {
         /// (mode_K.pvd) as VTK to this directory.
         #[arg(long, value_name = "DIR")]
         vtk: Option<PathBuf>,
-        /// With --vtk: draw superelements as the chord between their nodes,
-        /// not as their FE mesh (smaller files for large meshes).
-        #[arg(long, requires = "vtk")]
-        vtk_chords: bool,
+        /// How --vtk draws superelements and beams.
+        #[command(flatten)]
+        vtk_style: vtk_out::VtkStyle,
     },
     /// Eigenfrequencies along the range of motion: over a load scale or a
     /// held coordinate, n equilibria, eigen analyses in parallel.
@@ -165,10 +163,9 @@ struct SimulateArgs {
     /// (simulate.pvd and one VTU file per output) to this directory.
     #[arg(long, value_name = "DIR")]
     vtk: Option<PathBuf>,
-    /// With --vtk: draw superelements as the chord between their nodes,
-    /// not as their FE mesh (smaller files for large meshes).
-    #[arg(long, requires = "vtk")]
-    vtk_chords: bool,
+    /// How --vtk draws superelements and beams.
+    #[command(flatten)]
+    vtk_style: vtk_out::VtkStyle,
 }
 
 /// Options of `flexmb sweep`.
@@ -218,10 +215,9 @@ struct SweepArgs {
     /// this directory.
     #[arg(long, value_name = "DIR")]
     vtk: Option<PathBuf>,
-    /// With --vtk: draw superelements as the chord between their nodes,
-    /// not as their FE mesh (smaller files for large meshes).
-    #[arg(long, requires = "vtk")]
-    vtk_chords: bool,
+    /// How --vtk draws superelements and beams.
+    #[command(flatten)]
+    vtk_style: vtk_out::VtkStyle,
 }
 
 /// Why a command failed, which decides the exit code.
@@ -310,13 +306,13 @@ fn run(command: Command) -> Result<(), Failure> {
             steps,
             out,
             vtk,
-            vtk_chords,
+            vtk_style,
         } => statics(
             &scene,
             time,
             steps,
             &out,
-            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_chords)),
+            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_style)),
         ),
         Command::Simulate(a) => simulate(&a),
         Command::Eig {
@@ -325,13 +321,13 @@ fn run(command: Command) -> Result<(), Failure> {
             static_first,
             buckling,
             vtk,
-            vtk_chords,
+            vtk_style,
         } => eig(
             &scene,
             modes,
             static_first,
             buckling,
-            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_chords)),
+            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_style)),
         ),
         Command::Sweep(a) => sweep(&a),
         Command::Reduce(a) => reduce::reduce(&a),
@@ -549,7 +545,7 @@ fn simulate(a: &SimulateArgs) -> Result<(), Failure> {
             .map(|(t, x)| (*t, x.as_slice()))
             .collect();
         vtk_out::write(
-            vtk_out::VtkOut::new(d, a.vtk_chords),
+            vtk_out::VtkOut::new(d, a.vtk_style),
             "simulate",
             &mech,
             &frames,
@@ -850,7 +846,7 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
     }
     write_frequency_sweep(&sw, &comments, &a.out)?;
     if let Some(d) = &a.vtk {
-        vtk_out::write_sweep_points(vtk_out::VtkOut::new(d, a.vtk_chords), &mech, a.t_load, &pts)?;
+        vtk_out::write_sweep_points(vtk_out::VtkOut::new(d, a.vtk_style), &mech, a.t_load, &pts)?;
     }
     if outcome.stopped {
         return Err(Failure::Interrupted(format!(

@@ -38,6 +38,8 @@ struct Expanded {
     group: String,
     element: Element,
     attach: Vec<Attach>,
+    /// A beam's section, for drawing.
+    section: Option<crate::BeamSection>,
 }
 
 /// An element built in Rust code, for instance a user-defined element
@@ -356,22 +358,34 @@ pub(crate) fn assemble<'s>(
                     } else {
                         format!("{id}.{}", k + 1)
                     };
-                    let element = match dim {
-                        Dimension::Planar => Element::planar_beam(
-                            [pa[0], pa[1]],
-                            [pb[0], pb[1]],
-                            &mat,
-                            &shape,
-                            &opts,
-                        )
-                        .map_err(wrap)?,
+                    let (element, frame) = match dim {
+                        Dimension::Planar => {
+                            let (dx, dy) = (pb[0] - pa[0], pb[1] - pa[1]);
+                            let l = dx.hypot(dy);
+                            let (c, s) = if l > 0.0 {
+                                (dx / l, dy / l)
+                            } else {
+                                (1.0, 0.0)
+                            };
+                            (
+                                Element::planar_beam(
+                                    [pa[0], pa[1]],
+                                    [pb[0], pb[1]],
+                                    &mat,
+                                    &shape,
+                                    &opts,
+                                )
+                                .map_err(wrap)?,
+                                [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]],
+                            )
+                        }
                         Dimension::Spatial => {
                             let axis = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
                             let up = match &b.up {
                                 Some(u) => vec3(&ctx, "up", u)?,
                                 None => default_up(&axis),
                             };
-                            Element::beam(
+                            let element = Element::beam(
                                 [pa[0], pa[1], pa[2]],
                                 [pb[0], pb[1], pb[2]],
                                 up,
@@ -379,7 +393,11 @@ pub(crate) fn assemble<'s>(
                                 &shape,
                                 &opts,
                             )
-                            .map_err(wrap)?
+                            .map_err(wrap)?;
+                            // the element checked the axis and up
+                            let frame =
+                                flexmb_element::frame_from_axis(&axis, &up).map_err(wrap)?;
+                            (element, frame)
                         }
                     };
                     let mut attach = vec![
@@ -397,6 +415,11 @@ pub(crate) fn assemble<'s>(
                         group: id.clone(),
                         element,
                         attach,
+                        section: Some(crate::BeamSection {
+                            shape,
+                            frame,
+                            planar: dim == Dimension::Planar,
+                        }),
                     });
                 }
             }
@@ -436,6 +459,7 @@ pub(crate) fn assemble<'s>(
                         group: id.clone(),
                         element,
                         attach: vec![Attach::Pos(a.clone()), Attach::Pos(bb.clone())],
+                        section: None,
                     });
                 }
             }
@@ -465,6 +489,7 @@ pub(crate) fn assemble<'s>(
                         Attach::Orient(nodes.0.clone()),
                         Attach::Orient(nodes.1.clone()),
                     ],
+                    section: None,
                 });
             }
             ElementSpec::PointMass {
@@ -500,6 +525,7 @@ pub(crate) fn assemble<'s>(
                     group: id.clone(),
                     element,
                     attach,
+                    section: None,
                 });
             }
             ElementSpec::RigidBody {
@@ -534,6 +560,7 @@ pub(crate) fn assemble<'s>(
                     group: id.clone(),
                     element,
                     attach: vec![Attach::Pos(node.clone()), Attach::Carried(node.clone())],
+                    section: None,
                 });
             }
             ElementSpec::Superelement {
@@ -609,6 +636,7 @@ pub(crate) fn assemble<'s>(
                         Attach::Group(gq),
                         Attach::Group(gf),
                     ],
+                    section: None,
                 });
             }
         }
@@ -665,6 +693,7 @@ pub(crate) fn assemble<'s>(
             group: c.id.clone(),
             element: c.element.clone(),
             attach,
+            section: None,
         });
     }
     if expanded.is_empty() {
@@ -797,6 +826,7 @@ pub(crate) fn assemble<'s>(
         }
         elements.push(MechElement {
             superelement: part_data.remove(&e.id),
+            section: e.section,
             id: e.id,
             group: e.group,
             element: e.element,
@@ -817,6 +847,7 @@ pub(crate) fn assemble<'s>(
                     x_index: o.clone(),
                     eps_offset,
                     superelement: None,
+                    section: None,
                 });
             }
         }

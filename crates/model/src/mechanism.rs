@@ -62,6 +62,9 @@ pub struct MechElement {
     /// λq, η̄) with η̄ its p, q and normal mode groups in turn. `None` for
     /// the other elements.
     pub superelement: Option<Arc<LinearSuperelement>>,
+    /// A beam's cross-section and reference frame, for drawing it as a box
+    /// ([`crate::BeamSection`]); `None` for the other elements.
+    pub section: Option<crate::BeamSection>,
 }
 
 impl MechElement {
