@@ -185,8 +185,7 @@ impl<'a> Drawing<'a> {
         for b in &mut self.boxes {
             let el = &mech.elements[b.element];
             let section = el.section.as_ref().expect("a beam");
-            el.gather(x, &mut b.gathered);
-            el.element.measured_coordinates(&b.gathered, &mut b.local);
+            el.measured_at(x, &mut b.gathered, &mut b.local);
             for (k, st) in section.stations(&b.local, BOX_SEGMENTS).iter().enumerate() {
                 let at = b.offset + 4 * k;
                 out[at..at + 4].copy_from_slice(&section.corners(st));
@@ -237,15 +236,7 @@ impl<'a> Drawing<'a> {
         let mech = self.mech;
         for p in &mut self.parts {
             let el = &mech.elements[p.element];
-            el.gather(x, &mut p.gathered);
-            el.element.measured_coordinates(&p.gathered, &mut p.local);
-            for at in [3, 10] {
-                let lam = &mut p.local[at..at + 4];
-                let n = lam.iter().map(|v| v * v).sum::<f64>().sqrt();
-                if n > 0.0 {
-                    lam.iter_mut().for_each(|v| *v /= n);
-                }
-            }
+            el.measured_at(x, &mut p.gathered, &mut p.local);
             let n = p.recovery.mesh().nodes.len();
             p.recovery
                 .positions(&p.local, &mut out[p.offset..p.offset + n])
