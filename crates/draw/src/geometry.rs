@@ -6,12 +6,13 @@
 //! centre line (the four edges along it and the section at each end), and
 //! a superelement whose file has its FE mesh as the outline of that mesh,
 //! recovered at the configuration (`flexmb_superelement::recovery`): the
-//! edges of its boundary faces ([`flexmb_element::fe_faces`]), not the
-//! internal ones. [`Style::Lines`] draws beams as lines between their
+//! edges where its boundary faces meet at more than [`OUTLINE_ANGLE_DEG`]
+//! at the reference ([`flexmb_element::fe_faces::feature_edges`]): the
+//! part's outline, without internal edges or the grid lines of flat faces. [`Style::Lines`] draws beams as lines between their
 //! nodes and superelements as their chord.
 
 use crate::View;
-use flexmb_element::fe_faces::boundary_edges;
+use flexmb_element::fe_faces::feature_edges;
 use flexmb_element::Slot;
 use flexmb_model::{Mechanism, XRole};
 use flexmb_superelement::recovery::MeshRecovery;
@@ -30,6 +31,10 @@ pub enum Style {
 
 /// Segments of a beam's centre line drawn by [`Style::Outline`].
 pub const BEAM_STATIONS: usize = 8;
+
+/// The angle (degrees) between two boundary faces of a superelement's mesh
+/// above which their common edge belongs to its outline.
+pub const OUTLINE_ANGLE_DEG: f64 = 30.0;
 
 /// What an item of a picture stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -205,7 +210,7 @@ fn beam_box(mech: &Mechanism, k: usize, x: &[f64]) -> Option<Vec<Vec<[f64; 3]>>>
     Some(out)
 }
 
-/// The boundary edges of a superelement's FE mesh recovered at `x` (each a
+/// The outline edges of a superelement's FE mesh recovered at `x` (each a
 /// polyline through its midside node, if any); `None` without a mesh with
 /// cells, or where the mesh cannot be placed.
 fn superelement_outline(mech: &Mechanism, k: usize, x: &[f64]) -> Option<Vec<Vec<[f64; 3]>>> {
@@ -222,7 +227,7 @@ fn superelement_outline(mech: &Mechanism, k: usize, x: &[f64]) -> Option<Vec<Vec
     let mut at = vec![[0.0; 3]; mesh.nodes.len()];
     recovery.positions(&local, &mut at).ok()?;
     Some(
-        boundary_edges(&mesh.cells)
+        feature_edges(&mesh.cells, &mesh.nodes, OUTLINE_ANGLE_DEG.to_radians())
             .iter()
             .map(|e| e.iter().map(|&i| at[i]).collect())
             .collect(),

@@ -22,6 +22,7 @@ mod view;
 
 pub use geometry::{
     geometry, node_positions, styled_geometry, Geometry, Item, ItemKind, Style, BEAM_STATIONS,
+    OUTLINE_ANGLE_DEG,
 };
 pub use mode::{check_mode, mode_shape, Configuration, ModeShape};
 pub use picture::{

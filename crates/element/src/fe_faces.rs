@@ -130,6 +130,55 @@ pub fn boundary_edges(cells: &[FeCell]) -> Vec<Vec<usize>> {
     out
 }
 
+/// The feature edges of `cells` with nodes at `x`: the edges around the
+/// boundary faces (as [`boundary_edges`] gives them) where the two
+/// boundary faces that meet turn by more than `angle` (radians) against
+/// each other, and edges of one boundary face only. A mesh's outline: the
+/// edges of a box-shaped part, not the grid lines on its flat faces. The
+/// normals are those of the faces' corners (Newell's).
+pub fn feature_edges(cells: &[FeCell], x: &[[f64; 3]], angle: f64) -> Vec<Vec<usize>> {
+    let faces = boundary_faces(cells);
+    let normal = |f: &[usize]| -> [f64; 3] {
+        let c = face_corners(f.len());
+        let mut n = [0.0; 3];
+        for i in 0..c {
+            let (a, b) = (x[f[i]], x[f[(i + 1) % c]]);
+            n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+            n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+            n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+        }
+        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if l > 0.0 {
+            n.map(|v| v / l)
+        } else {
+            n
+        }
+    };
+    let normals: Vec<[f64; 3]> = faces.iter().map(|f| normal(f)).collect();
+    let mut of_edge: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+    for (k, f) in faces.iter().enumerate() {
+        let c = face_corners(f.len());
+        for i in 0..c {
+            let (a, b) = (f[i], f[(i + 1) % c]);
+            of_edge.entry((a.min(b), a.max(b))).or_default().push(k);
+        }
+    }
+    let cos = angle.cos();
+    boundary_edges(cells)
+        .into_iter()
+        .filter(|e| {
+            let (a, b) = (e[0], e[e.len() - 1]);
+            match of_edge[&(a.min(b), a.max(b))].as_slice() {
+                [f, g] => {
+                    let (n, m) = (normals[*f], normals[*g]);
+                    n[0] * m[0] + n[1] * m[1] + n[2] * m[2] < cos
+                }
+                _ => true,
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -151,13 +200,14 @@ mod tests {
             [1., 1., 1.],
             [0., 1., 1.],
         ];
+        // VTK's wedge: the base triangle turns about −z (away from the top)
         let wedge = vec![
             [0., 0., 0.],
-            [1., 0., 0.],
             [0., 1., 0.],
+            [1., 0., 0.],
             [0., 0., 1.],
-            [1., 0., 1.],
             [0., 1., 1.],
+            [1., 0., 1.],
         ];
         let with_mids = |c: &Vec<[f64; 3]>, edges: &[(usize, usize)]| {
             let mut x = c.clone();
@@ -281,5 +331,36 @@ mod tests {
         let edges = boundary_edges(&cells);
         assert_eq!(edges.len(), 20);
         assert!(edges.iter().all(|e| e.len() == 2));
+        // the box 2 × 1 × 1: its 12 edges, the 4 along x in two pieces (the
+        // 4 around the shared face lie in flat faces, 0° apart), for any
+        // angle below 90°
+        let x: Vec<[f64; 3]> = vec![
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [1., 1., 0.],
+            [0., 1., 0.],
+            [0., 0., 1.],
+            [1., 0., 1.],
+            [1., 1., 1.],
+            [0., 1., 1.],
+            [2., 0., 0.],
+            [2., 1., 0.],
+            [2., 0., 1.],
+            [2., 1., 1.],
+        ];
+        for deg in [1.0f64, 30.0, 89.0] {
+            let f = feature_edges(&cells, &x, deg.to_radians());
+            assert_eq!(f.len(), 16, "{deg}°: {f:?}");
+            for e in &f {
+                let (a, b) = (x[e[0]], x[e[1]]);
+                let along = (0..3).filter(|&d| a[d] != b[d]).count();
+                assert_eq!(along, 1);
+                assert!(
+                    !(a[0] == 1.0 && b[0] == 1.0),
+                    "an edge of the shared face: {e:?}"
+                );
+            }
+        }
+        assert_eq!(feature_edges(&cells, &x, 91f64.to_radians()).len(), 0);
     }
 }
