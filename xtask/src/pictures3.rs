@@ -6,11 +6,9 @@
 //! sign of ϕ, §3.5.1).
 
 use crate::ch3::{self, Kind};
-use crate::pictures::{equilibrium, save};
+use crate::pictures::{equilibrium, mode_pictures};
 use crate::report::{sig, Figures, Table};
-use flexmb_draw::{
-    styled_geometry, Configuration, DrawOptions, Layer, Picture, Style, View, REFERENCE_COLOR,
-};
+use flexmb_draw::{styled_geometry, Configuration, Layer, Picture, Style, View, REFERENCE_COLOR};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::Arc;
@@ -101,29 +99,22 @@ pub fn draw(dir: &Path, file: &str, out: &Path, figs: &mut Figures) -> Result<Dr
         figs.save(&pic.plot(), out, stem).map_err(io)?;
     }
     let tags = ["rest", "neg", "pos"];
-    let mut drawn = vec![];
-    for ((m, at), tag) in MOMENTS.iter().zip(&ats).zip(tags) {
-        let phi = end_rotation(at);
-        let mut f = vec![];
-        for k in MODES {
-            let hz = save(
-                figs,
-                out,
-                &format!("mech_mode{k}_{tag}"),
-                at,
-                &DrawOptions {
-                    mode: Some(k),
-                    phases: Some(2),
-                    title: Some(format!("SE-CW at M = {m:+.1} N m (ϕ = {phi:+.1}°)")),
-                    ..Default::default()
-                },
-            )
-            .map_err(io)?
-            .unwrap_or(f64::NAN);
-            f.push(hz);
-        }
-        drawn.push((*m, phi, f));
-    }
+    let titled: Vec<(&Configuration, &str, String)> = MOMENTS
+        .iter()
+        .zip(&ats)
+        .zip(tags)
+        .map(|((m, at), tag)| {
+            let title = format!("SE-CW at M = {m:+.1} N m (ϕ = {:+.1}°)", end_rotation(at));
+            (at, tag, title)
+        })
+        .collect();
+    let f = mode_pictures(figs, out, &MODES, &titled).map_err(io)?;
+    let drawn = MOMENTS
+        .iter()
+        .zip(&ats)
+        .zip(f)
+        .map(|((m, at), f)| (*m, end_rotation(at), f))
+        .collect();
     Ok(drawn)
 }
 

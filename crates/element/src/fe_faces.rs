@@ -138,23 +138,18 @@ pub fn boundary_edges(cells: &[FeCell]) -> Vec<Vec<usize>> {
 /// normals are those of the faces' corners (Newell's).
 pub fn feature_edges(cells: &[FeCell], x: &[[f64; 3]], angle: f64) -> Vec<Vec<usize>> {
     let faces = boundary_faces(cells);
-    let normal = |f: &[usize]| -> [f64; 3] {
-        let c = face_corners(f.len());
-        let mut n = [0.0; 3];
-        for i in 0..c {
-            let (a, b) = (x[f[i]], x[f[(i + 1) % c]]);
-            n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-            n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-            n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-        }
-        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        if l > 0.0 {
-            n.map(|v| v / l)
-        } else {
-            n
-        }
-    };
-    let normals: Vec<[f64; 3]> = faces.iter().map(|f| normal(f)).collect();
+    let normals: Vec<[f64; 3]> = faces
+        .iter()
+        .map(|f| {
+            let n = newell(f[..face_corners(f.len())].iter().map(|&i| x[i]));
+            let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if l > 0.0 {
+                n.map(|v| v / l)
+            } else {
+                n
+            }
+        })
+        .collect();
     let mut of_edge: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
     for (k, f) in faces.iter().enumerate() {
         let c = face_corners(f.len());
@@ -177,6 +172,20 @@ pub fn feature_edges(cells: &[FeCell], x: &[[f64; 3]], angle: f64) -> Vec<Vec<us
             }
         })
         .collect()
+}
+
+/// Newell's normal of a polygon (twice its area along its right-hand
+/// normal, for a planar one).
+fn newell(corners: impl Iterator<Item = [f64; 3]> + Clone) -> [f64; 3] {
+    let first = corners.clone().next();
+    let next = corners.clone().skip(1).chain(first);
+    let mut n = [0.0; 3];
+    for (a, b) in corners.zip(next) {
+        n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    }
+    n
 }
 
 #[cfg(test)]
@@ -277,13 +286,7 @@ mod tests {
             for f in faces {
                 let c = face_corners(f.len());
                 let p: Vec<[f64; 3]> = f[..c].iter().map(|&i| x[i]).collect();
-                let mut n = [0.0; 3];
-                for i in 0..c {
-                    let (a, b) = (p[i], p[(i + 1) % c]);
-                    n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-                    n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-                    n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-                }
+                let n = newell(p.iter().copied());
                 let mid: [f64; 3] =
                     std::array::from_fn(|d| p.iter().map(|q| q[d]).sum::<f64>() / c as f64);
                 let out: f64 = (0..3).map(|d| n[d] * (mid[d] - centre[d])).sum();

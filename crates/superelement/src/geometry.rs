@@ -75,6 +75,50 @@ impl SolidKind {
     }
 }
 
+/// The edges of the midside nodes of the quadratic kinds in the
+/// Abaqus/CalculiX order: midside node `corners + k` lies on the edge
+/// between the corners `midside_edges()[k]`.
+const TET10_EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)];
+const HEX20_EDGES: [(usize, usize); 12] = [
+    (0, 1),
+    (1, 2),
+    (2, 3),
+    (3, 0),
+    (4, 5),
+    (5, 6),
+    (6, 7),
+    (7, 4),
+    (0, 4),
+    (1, 5),
+    (2, 6),
+    (3, 7),
+];
+const WEDGE15_EDGES: [(usize, usize); 9] = [
+    (0, 1),
+    (1, 2),
+    (2, 0),
+    (3, 4),
+    (4, 5),
+    (5, 3),
+    (0, 3),
+    (1, 4),
+    (2, 5),
+];
+
+impl SolidKind {
+    /// The corner pairs of the midside nodes, in the Abaqus/CalculiX order
+    /// (empty for the linear kinds): node `n_nodes() − len + k` is the
+    /// middle of edge k.
+    pub fn midside_edges(self) -> &'static [(usize, usize)] {
+        match self {
+            SolidKind::Tet10 => &TET10_EDGES,
+            SolidKind::Hex20 => &HEX20_EDGES,
+            SolidKind::Wedge15 => &WEDGE15_EDGES,
+            _ => &[],
+        }
+    }
+}
+
 /// Abaqus C3D6 → VTK_WEDGE: VTK's base triangle (0, 1, 2) turns the other
 /// way (its right-hand normal points away from the top face (3, 4, 5),
 /// vtkWedge's documentation and face table), Abaqus's 1-2-3 towards it.
@@ -555,20 +599,7 @@ mod tests {
         let x8: Vec<[f64; 3]> = (0..8).map(corner).collect();
         check("C3D8", element_moments(SolidKind::Hex8, &x8, c).unwrap());
         let mut x20 = x8.clone();
-        for (p, q) in [
-            (0, 1),
-            (1, 2),
-            (2, 3),
-            (3, 0),
-            (4, 5),
-            (5, 6),
-            (6, 7),
-            (7, 4),
-            (0, 4),
-            (1, 5),
-            (2, 6),
-            (3, 7),
-        ] {
+        for &(p, q) in SolidKind::Hex20.midside_edges() {
             x20.push(mid(corner(p), corner(q)));
         }
         check("C3D20", element_moments(SolidKind::Hex20, &x20, c).unwrap());

@@ -293,39 +293,6 @@ const GMSH_UNSUPPORTED: [(u32, &str); 7] = [
     ),
 ];
 
-/// The Abaqus/CalculiX edges of the midside nodes of `kind`, in their order.
-fn abaqus_edges(kind: SolidKind) -> Edges {
-    match kind {
-        SolidKind::Tet10 => &[(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)],
-        SolidKind::Hex20 => &[
-            (0, 1),
-            (1, 2),
-            (2, 3),
-            (3, 0),
-            (4, 5),
-            (5, 6),
-            (6, 7),
-            (7, 4),
-            (0, 4),
-            (1, 5),
-            (2, 6),
-            (3, 7),
-        ],
-        SolidKind::Wedge15 => &[
-            (0, 1),
-            (1, 2),
-            (2, 0),
-            (3, 4),
-            (4, 5),
-            (5, 3),
-            (0, 3),
-            (1, 4),
-            (2, 5),
-        ],
-        _ => &[],
-    }
-}
-
 /// The permutation taking gmsh's node order of a volume element to the
 /// Abaqus/CalculiX one: node k of Abaqus is node `perm[k]` of gmsh. The
 /// corners are in the same order in both; the midside nodes are matched
@@ -333,7 +300,7 @@ fn abaqus_edges(kind: SolidKind) -> Edges {
 fn gmsh_to_abaqus(kind: SolidKind, gmsh_edges: &[(usize, usize)]) -> Vec<usize> {
     let corners = kind.n_nodes() - gmsh_edges.len();
     let mut perm: Vec<usize> = (0..corners).collect();
-    for &(a, b) in abaqus_edges(kind) {
+    for &(a, b) in kind.midside_edges() {
         let j = gmsh_edges
             .iter()
             .position(|&(c, d)| (c, d) == (a, b) || (c, d) == (b, a))
@@ -1101,7 +1068,7 @@ mod tests {
             let perm = gmsh_to_abaqus(kind, edges);
             assert_eq!(perm.len(), kind.n_nodes());
             let corners = kind.n_nodes() - edges.len();
-            for (k, &(a, b)) in abaqus_edges(kind).iter().enumerate() {
+            for (k, &(a, b)) in kind.midside_edges().iter().enumerate() {
                 let (c, d) = edges[perm[corners + k] - corners];
                 assert!((c, d) == (a, b) || (c, d) == (b, a), "{kind:?} midside {k}");
             }

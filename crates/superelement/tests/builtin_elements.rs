@@ -43,50 +43,18 @@ fn reference(kind: SolidKind) -> Vec<[f64; 3]> {
         [1., 0., 1.],
         [0., 1., 1.],
     ];
-    let mids = |c: Vec<[f64; 3]>, e: &[(usize, usize)]| {
-        let mut x = c.clone();
-        for &(a, b) in e {
-            x.push(std::array::from_fn(|d| 0.5 * (c[a][d] + c[b][d])));
-        }
-        x
+    let corners = match kind {
+        SolidKind::Tet4 | SolidKind::Tet10 => tet,
+        SolidKind::Hex8 | SolidKind::Hex20 => hex,
+        SolidKind::Wedge6 | SolidKind::Wedge15 => wedge,
     };
-    match kind {
-        SolidKind::Tet4 => tet,
-        SolidKind::Tet10 => mids(tet, &[(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]),
-        SolidKind::Hex8 => hex,
-        SolidKind::Hex20 => mids(
-            hex,
-            &[
-                (0, 1),
-                (1, 2),
-                (2, 3),
-                (3, 0),
-                (4, 5),
-                (5, 6),
-                (6, 7),
-                (7, 4),
-                (0, 4),
-                (1, 5),
-                (2, 6),
-                (3, 7),
-            ],
-        ),
-        SolidKind::Wedge6 => wedge,
-        SolidKind::Wedge15 => mids(
-            wedge,
-            &[
-                (0, 1),
-                (1, 2),
-                (2, 0),
-                (3, 4),
-                (4, 5),
-                (5, 3),
-                (0, 3),
-                (1, 4),
-                (2, 5),
-            ],
-        ),
+    let mut x = corners.clone();
+    for &(a, b) in kind.midside_edges() {
+        x.push(std::array::from_fn(|d| {
+            0.5 * (corners[a][d] + corners[b][d])
+        }));
     }
+    x
 }
 
 /// One element of `kind`: an affine image (stretched, sheared, turned) of
