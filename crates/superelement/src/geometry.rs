@@ -106,6 +106,16 @@ const WEDGE15_EDGES: [(usize, usize); 9] = [
 ];
 
 impl SolidKind {
+    /// Every kind.
+    pub const ALL: [SolidKind; 6] = [
+        SolidKind::Tet4,
+        SolidKind::Tet10,
+        SolidKind::Hex8,
+        SolidKind::Hex20,
+        SolidKind::Wedge6,
+        SolidKind::Wedge15,
+    ];
+
     /// The corner pairs of the midside nodes, in the Abaqus/CalculiX order
     /// (empty for the linear kinds): node `n_nodes() − len + k` is the
     /// middle of edge k.
@@ -635,17 +645,7 @@ mod tests {
                 .collect();
             w6.add_scaled(&element_moments(SolidKind::Wedge6, &x, c).unwrap(), 1.0);
             let mut x15 = x.clone();
-            for (p, r) in [
-                (0, 1),
-                (1, 2),
-                (2, 0),
-                (3, 4),
-                (4, 5),
-                (5, 3),
-                (0, 3),
-                (1, 4),
-                (2, 5),
-            ] {
+            for &(p, r) in SolidKind::Wedge15.midside_edges() {
                 x15.push(mid(x[p], x[r]));
             }
             w15.add_scaled(&element_moments(SolidKind::Wedge15, &x15, c).unwrap(), 1.0);
@@ -658,14 +658,7 @@ mod tests {
     /// at every quadrature point.
     #[test]
     fn shape_functions_are_a_partition_of_unity() {
-        for kind in [
-            SolidKind::Tet4,
-            SolidKind::Tet10,
-            SolidKind::Hex8,
-            SolidKind::Hex20,
-            SolidKind::Wedge6,
-            SolidKind::Wedge15,
-        ] {
+        for kind in SolidKind::ALL {
             for (p, _) in rule(kind) {
                 let (n, dn) = shape(kind, p);
                 assert_eq!(n.len(), kind.n_nodes());

@@ -975,14 +975,7 @@ pub fn calculix_deck(mesh: &MeshFile, material: &MeshMaterial, title: &str) -> S
             ccx_number(x[2])
         ));
     }
-    for kind in [
-        SolidKind::Tet4,
-        SolidKind::Tet10,
-        SolidKind::Hex8,
-        SolidKind::Hex20,
-        SolidKind::Wedge6,
-        SolidKind::Wedge15,
-    ] {
+    for kind in SolidKind::ALL {
         let of_kind: Vec<usize> = (0..mesh.kinds.len())
             .filter(|&e| mesh.kinds[e] == kind)
             .collect();

@@ -116,14 +116,7 @@ fn largest_difference(a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
 #[test]
 fn every_builtin_element_equals_calculix() {
     let dir = std::env::temp_dir().join(format!("flexmb-builtin-elements-{}", std::process::id()));
-    for kind in [
-        SolidKind::Tet4,
-        SolidKind::Tet10,
-        SolidKind::Hex8,
-        SolidKind::Hex20,
-        SolidKind::Wedge6,
-        SolidKind::Wedge15,
-    ] {
+    for kind in SolidKind::ALL {
         let mesh = one_element(kind, 0.03);
         let own = mesh
             .solid_mesh(MATERIAL.material().unwrap())
