@@ -125,6 +125,9 @@ enum Command {
     /// Build a linear superelement: from FE matrices named in a spec file
     /// (see crates/superelement/README.md), or in one command from a mesh
     /// (--mesh, see docs/superelement.md).
+    #[command(
+        override_usage = "flexmb build-superelement SPEC.ron\n       flexmb build-superelement --mesh PART.msh|PART.geo|PART.inp --material M --interface p=… --interface q=… [OPTIONS]"
+    )]
     BuildSuperelement(superelement::SuperelementArgs),
 }
 
