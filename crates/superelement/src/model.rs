@@ -318,18 +318,26 @@ impl FeModel {
     /// tag, an *NSET; case-insensitive); an error listing the sets there are
     /// when there is none of that name.
     pub fn node_set(&self, name: &str) -> Result<&NodeSet, Error> {
-        let by_name = self.node_sets.iter().find(|s| s.name == name).or_else(|| {
-            self.node_sets
-                .iter()
-                .find(|s| s.name.eq_ignore_ascii_case(name))
-        });
+        // gmsh tags and names are per dimension: a surface first, as
+        // interfaces are surfaces
+        let surface_first = |s: &&NodeSet| !s.what.contains("surface");
+        let by_name = self
+            .node_sets
+            .iter()
+            .filter(|s| s.name == name)
+            .min_by_key(surface_first)
+            .or_else(|| {
+                self.node_sets
+                    .iter()
+                    .filter(|s| s.name.eq_ignore_ascii_case(name))
+                    .min_by_key(surface_first)
+            });
         let by_tag = || {
             let t: i64 = name.trim().parse().ok()?;
-            // a surface first: interfaces are surfaces
             self.node_sets
                 .iter()
                 .filter(|s| s.tag == Some(t))
-                .min_by_key(|s| !s.what.contains("surface"))
+                .min_by_key(surface_first)
         };
         by_name.or_else(by_tag).ok_or_else(|| {
             let there = if self.node_sets.is_empty() {
@@ -717,4 +725,61 @@ pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::Triplet;
+
+    /// Named node sets: by name (then without regard to case), by tag, a
+    /// surface before a volume of the same name or tag (gmsh numbers each
+    /// dimension apart), and an unknown name listing the sets with the
+    /// nearest.
+    #[test]
+    fn node_sets_are_found_by_name_or_tag_surfaces_first() {
+        let eye: Vec<Triplet<usize, usize, f64>> =
+            (0..6).map(|i| Triplet::new(i, i, 1.0)).collect();
+        let a = SparseColMat::try_new_from_triplets(6, 6, &eye).unwrap();
+        let mut m = FeModel::new(
+            "part",
+            vec![1, 2],
+            vec![[0.0; 3], [1.0, 0.0, 0.0]],
+            DofMap::full(2),
+            a.as_ref(),
+            a.as_ref(),
+        )
+        .unwrap();
+        let set = |name: &str, what: &str, tag: Option<i64>, nodes: Vec<usize>| NodeSet {
+            name: name.into(),
+            what: what.into(),
+            tag,
+            nodes,
+        };
+        m.node_sets = vec![
+            set("7", "physical volume", Some(7), vec![0, 1]),
+            set("7", "physical surface", Some(7), vec![1]),
+            set("Left", "physical surface", Some(2), vec![0]),
+            set("END", "node set", None, vec![1]),
+        ];
+        assert_eq!(m.node_set("7").unwrap().what, "physical surface");
+        assert_eq!(m.node_set("left").unwrap().nodes, vec![0]);
+        assert_eq!(m.node_set("2").unwrap().name, "Left");
+        assert_eq!(m.node_set("end").unwrap().name, "END");
+        let e = m.node_set("lef").unwrap_err().to_string();
+        assert!(
+            e.contains("no node set 'lef'") && e.contains("did you mean 'Left'"),
+            "{e}"
+        );
+        assert!(
+            e.contains("physical surface 'Left' (tag 2, 1 nodes)"),
+            "{e}"
+        );
+        assert_eq!(
+            NodeSelection::Set("END".into())
+                .resolve(&m, "interface q")
+                .unwrap(),
+            vec![1]
+        );
+    }
 }
