@@ -15,6 +15,7 @@ pub mod curves;
 pub mod fuzz;
 pub mod models;
 pub mod pictures;
+pub mod pictures3;
 pub mod progress;
 pub mod regress;
 pub mod report;
