@@ -187,7 +187,10 @@ pub fn reduced_frequencies(
     s_values: &[f64],
     count: usize,
 ) -> Result<Vec<Vec<f64>>, String> {
-    let chunk = s_values.len().div_ceil(rayon::current_num_threads().max(1)).max(1);
+    let chunk = s_values
+        .len()
+        .div_ceil(rayon::current_num_threads().max(1))
+        .max(1);
     let blocks: Vec<Result<Vec<Vec<f64>>, String>> = s_values
         .par_chunks(chunk)
         .map(|block| {
@@ -386,6 +389,11 @@ mod tests {
             .collect();
         let (f, a) = amplitude_spectrum(&y, dt);
         let k = (0..a.len()).max_by(|i, j| a[*i].total_cmp(&a[*j])).unwrap();
-        assert!((f[k] - 40.0).abs() < 1.0 && (a[k] - 0.3).abs() < 0.01, "{} {}", f[k], a[k]);
+        assert!(
+            (f[k] - 40.0).abs() < 1.0 && (a[k] - 0.3).abs() < 0.01,
+            "{} {}",
+            f[k],
+            a[k]
+        );
     }
 }

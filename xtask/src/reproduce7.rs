@@ -113,7 +113,10 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
     // 1. the reference configurations (no gravity, no controllers)
     let (mech, dofs) = ch7::mechanism(root, false, None)?;
     let values = ch7::reference_values(o.n_reference);
-    let bar = pg.bar("ch7 reference configurations along the path", 2 * values.len() as u64);
+    let bar = pg.bar(
+        "ch7 reference configurations along the path",
+        2 * values.len() as u64,
+    );
     let t = Instant::now();
     let points = sweep::run(&mech, dofs, &values, ch7::R, &|d, _| bar.set(d as u64))?;
     let sweep_seconds = t.elapsed().as_secs_f64();
@@ -138,7 +141,9 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
     let (lmech, _) = ch7::mechanism(root, false, Some(&refs))?;
     let mut lm = ch7::reduced(&lmech, ibm_u)?;
     let z0 = vec![0.0; lm.n_z()];
-    let lin = lm.linearize(0.0, &z0, &z0, &z0).map_err(|e| e.to_string())?;
+    let lin = lm
+        .linearize(0.0, &z0, &z0, &z0)
+        .map_err(|e| e.to_string())?;
     let reduced_poles = poles(&lin.m, &lin.damping, &lin.stiffness)?;
     let mut dy = Dynamics::new(lmech.clone());
     let q0 = lmech.q0();
@@ -149,7 +154,8 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
     let unreduced_poles = poles(&full.m, &full.damping_total(), &full.stiffness_total())?;
     // 5. the closed loop with gravity
     let (cmech, _) = ch7::mechanism(root, true, Some(&refs))?;
-    let times = SimulationOptions::new(Integrator::Adams, 0.0, ch7::T_END, ch7::OUTPUTS).output_times;
+    let times =
+        SimulationOptions::new(Integrator::Adams, 0.0, ch7::T_END, ch7::OUTPUTS).output_times;
     let motion = ch7::reference_motion();
     let s_of_t: Vec<f64> = times.iter().map(|t| motion.value(*t)).collect();
     let angles: Vec<[f64; 2]> = times
@@ -193,11 +199,12 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
             z = eq.coordinates;
         }
         let bar = pg.bar(label, 1000);
-        let tr = MechanicalModel::simulate(&mut model, 0.0, &z, &z0, &adams(1e-3), &mut |t, _, _| {
-            bar.set((t / ch7::T_END * 1000.0) as u64);
-            Control::Continue
-        })
-        .map_err(|e| format!("{label}: {e}"))?;
+        let tr =
+            MechanicalModel::simulate(&mut model, 0.0, &z, &z0, &adams(1e-3), &mut |t, _, _| {
+                bar.set((t / ch7::T_END * 1000.0) as u64);
+                Control::Continue
+            })
+            .map_err(|e| format!("{label}: {e}"))?;
         bar.finish();
         runs.push(run_of(label, &cmech, &tr.full));
     }
@@ -218,7 +225,8 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
         })
     };
     let mut dy = Dynamics::new(cmech.clone());
-    let mut opts = SimulationOptions::new(Integrator::GeneralizedAlpha, 0.0, ch7::T_END, ch7::OUTPUTS);
+    let mut opts =
+        SimulationOptions::new(Integrator::GeneralizedAlpha, 0.0, ch7::T_END, ch7::OUTPUTS);
     opts.rtol = 1e-3;
     opts.atol = 1e-6;
     opts.stop = Some(stop.clone());
@@ -275,7 +283,11 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
     let s: Vec<f64> = r.points.iter().map(|p| p.s).collect();
     for (stem, title, modes) in [
         ("fig7_2_omega1_2", "Fig. 7.2: ω1, ω2 along the path", 0..2),
-        ("fig7_3_omega3_8", "Fig. 7.3: ω3–ω8 along the path", 2..ch7::R),
+        (
+            "fig7_3_omega3_8",
+            "Fig. 7.3: ω3–ω8 along the path",
+            2..ch7::R,
+        ),
     ] {
         let mut p = Plot::new(title, "arc length s (m)", "eigenfrequency (Hz)");
         for k in modes {
@@ -296,12 +308,8 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
         p.push(Series::line(name, &t, &a));
     }
     figs.save(&p, out, "fig7_4_reference")?;
-    let mut p = Plot::new(
-        "Fig. 7.5a: the end-effector in the plane",
-        "x (m)",
-        "y (m)",
-    )
-    .equal_aspect();
+    let mut p =
+        Plot::new("Fig. 7.5a: the end-effector in the plane", "x (m)", "y (m)").equal_aspect();
     let xy = |e: &[[f64; 3]]| -> (Vec<f64>, Vec<f64>) { e.iter().map(|p| (p[0], p[1])).unzip() };
     let (x, y) = xy(&r.reference);
     p.push(Series::line("reference", &x, &y));
@@ -316,7 +324,12 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
         "error (m)",
     );
     for (k, name) in ["x_ref − x", "y_ref − y"].iter().enumerate() {
-        let e: Vec<f64> = r.reference.iter().zip(&r.runs[1].ee).map(|(a, b)| a[k] - b[k]).collect();
+        let e: Vec<f64> = r
+            .reference
+            .iter()
+            .zip(&r.runs[1].ee)
+            .map(|(a, b)| a[k] - b[k])
+            .collect();
         p.push(Series::line(name, &t, &e));
     }
     figs.save(&p, out, "fig7_5b_errors")?;
@@ -381,14 +394,22 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
     let mut t = Table::new(&["", "thesis", "ours"]);
     let n_q = r.points[0].q.len();
     t.row(vec!["unreduced DOFs".into(), "688".into(), n_q.to_string()]);
-    t.row(vec!["reduced DOFs".into(), "8".into(), (1 + ch7::R - 1).to_string()]);
+    t.row(vec![
+        "reduced DOFs".into(),
+        "8".into(),
+        (1 + ch7::R - 1).to_string(),
+    ]);
     t.row(vec![
         "reference configurations (sweep time)".into(),
         "100".into(),
         format!("{} ({:.1} s)", r.points.len(), r.sweep_seconds),
     ]);
     for (v, secs, _) in &r.reduced {
-        t.row(vec![format!("{} basis", v.label()), "–".into(), format!("{secs:.1} s")]);
+        t.row(vec![
+            format!("{} basis", v.label()),
+            "–".into(),
+            format!("{secs:.1} s"),
+        ]);
     }
     let _ = writeln!(s, "{}", t.render());
     let _ = writeln!(s, "## Eigenfrequencies along the path (Figs 7.2, 7.3)\n\nThe reduced models' rest linearization (F.7) at z = (s, 0) against the unreduced one at the reference configurations (the end-effector held there, its holding force a dead load): the largest relative difference of each mode along the path.\n");
@@ -403,11 +424,17 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
     let _ = writeln!(s, "{}", t.render());
     s += &figs.markdown(|f| f.starts_with("fig7_2") || f.starts_with("fig7_3"));
     let _ = writeln!(s, "## Closed-loop poles at s = 0 (Table 7.2)\n\nPD controllers (7.12) with Table 7.1's gains on the actuator hinges, no gravity, the state-space eigenvalues of the linearization:\n");
-    let mut t = Table::new(&["mode", "thesis (Hz, ζ)", "IBM-u (Hz, ζ)", "unreduced (Hz, ζ)"]);
+    let mut t = Table::new(&[
+        "mode",
+        "thesis (Hz, ζ)",
+        "IBM-u (Hz, ζ)",
+        "unreduced (Hz, ζ)",
+    ]);
     for k in 0..2 {
         let f = |p: &[flexmb_linearize::DampedMode]| {
-            p.get(k)
-                .map_or("–".into(), |m| format!("{}, {:.3}", sig(m.frequency_hz), m.damping_ratio))
+            p.get(k).map_or("–".into(), |m| {
+                format!("{}, {:.3}", sig(m.frequency_hz), m.damping_ratio)
+            })
         };
         t.row(vec![
             (k + 1).to_string(),
@@ -476,7 +503,10 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
         pk.join(", ")
     );
     s += &figs.markdown(|f| {
-        f.starts_with("fig7_4") || f.starts_with("fig7_5") || f.starts_with("fig7_6") || f.starts_with("fig7_7")
+        f.starts_with("fig7_4")
+            || f.starts_with("fig7_5")
+            || f.starts_with("fig7_6")
+            || f.starts_with("fig7_7")
     });
     let _ = Path4::new();
     s

@@ -226,15 +226,14 @@ impl Expander<'_> {
                 Dimension::Planar => {
                     let (dx, dy) = (pb[0] - pa[0], pb[1] - pa[1]);
                     let l = dx.hypot(dy);
-                    let (c, s) = if l > 0.0 { (dx / l, dy / l) } else { (1.0, 0.0) };
-                    let element = Element::planar_beam(
-                        [pa[0], pa[1]],
-                        [pb[0], pb[1]],
-                        &mat,
-                        &shape,
-                        &opts,
-                    )
-                    .map_err(element_error(id))?;
+                    let (c, s) = if l > 0.0 {
+                        (dx / l, dy / l)
+                    } else {
+                        (1.0, 0.0)
+                    };
+                    let element =
+                        Element::planar_beam([pa[0], pa[1]], [pb[0], pb[1]], &mat, &shape, &opts)
+                            .map_err(element_error(id))?;
                     (element, [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
                 }
                 Dimension::Spatial => {
