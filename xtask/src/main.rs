@@ -1,4 +1,4 @@
-//! `cargo xtask reproduce ch2|ch3|ch5|ch6|all`, `cargo xtask regress` and `cargo xtask fuzz`.
+//! `cargo xtask reproduce ch2|ch3|ch4|ch5|ch6|ch7|all`, `cargo xtask regress` and `cargo xtask fuzz`.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -20,8 +20,10 @@ struct Cli {
 enum Chapter {
     Ch2,
     Ch3,
+    Ch4,
     Ch5,
     Ch6,
+    Ch7,
     All,
 }
 
@@ -39,7 +41,7 @@ enum FuzzTarget {
 enum Cmd {
     /// Regenerate a chapter's results into OUT/chN (CSV, SVG, report.md).
     Reproduce {
-        /// ch2, ch3, ch5, ch6 or all.
+        /// ch2, ch3, ch4, ch5, ch6, ch7 or all.
         chapter: Chapter,
         /// Output directory.
         #[arg(long, default_value = "results")]
@@ -66,7 +68,7 @@ enum Cmd {
         /// Store the recomputed curves as the new fixtures instead of comparing.
         #[arg(long)]
         update: bool,
-        /// Only this chapter's curves (ch2, ch3, ch5 or ch6; default all).
+        /// Only this chapter's curves (ch2, ch3, ch4, ch5 or ch6; default all).
         #[arg(long, value_enum)]
         chapter: Option<Chapter>,
     },
@@ -214,6 +216,15 @@ fn reproduce(
             out.join("ch3/report.md").display()
         ));
     }
+    if matches!(ch, Chapter::Ch4 | Chapter::All) {
+        let t = std::time::Instant::now();
+        xtask::reproduce4::reproduce(root, &out.join("ch4"), pg)?;
+        summary.push(format!(
+            "chapter 4 in {:.0} s: {}",
+            t.elapsed().as_secs_f64(),
+            out.join("ch4/report.md").display()
+        ));
+    }
     if matches!(ch, Chapter::Ch5 | Chapter::All) {
         let t = std::time::Instant::now();
         let rows = xtask::ch5::reproduce(root, &out.join("ch5"), pg)?;
@@ -235,6 +246,15 @@ fn reproduce(
         ));
         summary.extend(rows.iter().map(xtask::reproduce6::summary_line));
     }
+    if matches!(ch, Chapter::Ch7 | Chapter::All) {
+        let t = std::time::Instant::now();
+        xtask::reproduce7::reproduce(root, &out.join("ch7"), pg)?;
+        summary.push(format!(
+            "chapter 7 in {:.0} s: {}",
+            t.elapsed().as_secs_f64(),
+            out.join("ch7/report.md").display()
+        ));
+    }
     for l in summary {
         println!("{l}");
     }
@@ -248,9 +268,10 @@ fn regress(
     pg: &Progress,
 ) -> Result<(), String> {
     type Recompute = fn(&std::path::Path, &Progress) -> Result<xtask::regress::Recomputed, String>;
-    let chapters: [(Chapter, Recompute); 4] = [
+    let chapters: [(Chapter, Recompute); 5] = [
         (Chapter::Ch2, xtask::regress::recompute_ch2),
         (Chapter::Ch3, xtask::ch3::recompute),
+        (Chapter::Ch4, xtask::reproduce4::recompute),
         (Chapter::Ch5, xtask::regress::recompute_ch5),
         (Chapter::Ch6, xtask::regress::recompute_ch6),
     ];

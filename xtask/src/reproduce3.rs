@@ -73,8 +73,10 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
         figs.save(&p, out, &format!("fig3_10_omega{}", k + 1))
             .map_err(io)?;
     }
+    let drawn = crate::pictures3::draw(out, &segments[1].file, out, &mut figs)?;
     let wall = start.elapsed().as_secs_f64();
-    let md = report(&o, &curves, &segments, &dofs, &solid, &figs, wall);
+    let mut md = report(&o, &curves, &segments, &dofs, &solid, &figs, wall);
+    md.push_str(&crate::pictures3::section(&figs, &drawn));
     std::fs::write(out.join("report.md"), md).map_err(io)
 }
 
@@ -229,7 +231,7 @@ fn report(
     let _ = writeln!(s, "`xtask/tests/ch3_claims.rs` asserts the first three claims on the stored curves' mesh ({:?}).\n", ch3::CURVE_MESH);
     let _ = writeln!(s, "{}", against_solid(curves, solid));
     let _ = writeln!(s, "## Figures\n");
-    let _ = writeln!(s, "{}", figs.markdown(|_| true));
+    let _ = writeln!(s, "{}", figs.markdown(|f| !f.starts_with("mech_")));
     s
 }
 

@@ -39,19 +39,36 @@ pub const PARTITION_IMPROVEMENT: f64 = 4.0;
 pub const PARTITION_RECOVERY: f64 = 0.5;
 
 /// The state of a run's watch on the dependent set.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(crate) struct PartitionWatch {
     /// The pivot ratio of J just after the set was chosen (or last found
     /// to be the best one).
     pub(crate) reference: f64,
-    /// The estimated smallest singular value of J when the set was chosen.
-    pub(crate) quality: f64,
+    /// The configuration where the set was chosen.
+    x_chosen: Vec<f64>,
+    /// The estimated smallest singular value of J there, computed when a
+    /// run first needs it ([`quality`](Self::quality)): the pivoted QR over
+    /// every dependent coordinate is cubic in their number (5 s for the
+    /// 1520 of the chapter-4 mechanism with its end-effector's x and y as
+    /// DOFs), and most runs never degrade.
+    quality: Option<f64>,
 }
 
 impl PartitionWatch {
     /// Whether the pivot ratio `now` calls for a new choice.
     pub(crate) fn degraded(&self, now: f64) -> bool {
         now < PARTITION_SWITCH_RATIO * self.reference
+    }
+
+    /// The estimated smallest singular value of J at the configuration
+    /// where the set was chosen (`dy` on the same mechanism as then).
+    pub(crate) fn quality(&mut self, dy: &Dynamics) -> f64 {
+        if let Some(q) = self.quality {
+            return q;
+        }
+        let q = dy.set_quality_at(&self.x_chosen).unwrap_or(0.0);
+        self.quality = Some(q);
+        q
     }
 }
 
@@ -64,8 +81,39 @@ impl Dynamics {
         }
         Some(PartitionWatch {
             reference: self.kin.pivot_ratio(),
-            quality: self.current_set_quality().unwrap_or(0.0),
+            x_chosen: self.kin.x().to_vec(),
+            quality: None,
         })
+    }
+
+    /// [`current_set_quality`](Self::current_set_quality) at the nodal
+    /// coordinates `x` (element Jacobians evaluated there, not those of the
+    /// kinematics' current configuration).
+    fn set_quality_at(&self, x: &[f64]) -> Option<f64> {
+        let jacobians: Vec<Vec<f64>> = self
+            .mech
+            .elements
+            .iter()
+            .map(|e| {
+                let (ne, nx) = (e.element.n_eps(), e.element.n_x());
+                let mut xl = vec![0.0; nx];
+                e.gather(x, &mut xl);
+                let (mut eps, mut jac) = (vec![0.0; ne], vec![0.0; ne * nx]);
+                e.element
+                    .deformations_and_jacobian(&xl, None, &mut eps, &mut jac);
+                jac
+            })
+            .collect();
+        let eligible = self.mech.partition_eligible();
+        let (forced, rest): (Vec<usize>, Vec<usize>) = self
+            .mech
+            .dependent
+            .iter()
+            .partition(|i| !eligible.contains(i));
+        let cols: Vec<usize> = forced.iter().chain(&rest).copied().collect();
+        let a = constraint_jacobian(&self.mech, |k| &jacobians[k], &cols);
+        let n_c = self.mech.constraint_rows.len();
+        pivoted_qr_picks(a, n_c, cols.len(), forced.len()).map(|(_, r)| r)
     }
 
     /// The best-conditioned dependent set at the current (solved)

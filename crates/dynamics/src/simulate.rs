@@ -475,7 +475,8 @@ impl StepWatch {
         if !w.degraded(now) {
             return false;
         }
-        if dy.better_dependent_set(w.quality, &[]).is_some() {
+        let chosen = w.quality(dy);
+        if dy.better_dependent_set(chosen, &[]).is_some() {
             return true;
         }
         w.reference = now;
@@ -783,9 +784,12 @@ impl Dynamics {
             (q, qd) = (qs, qds);
             // the dependent set first, in the chart whose J the watch
             // measured; a new set or chart has a reference of its own
-            if let Some(w) = partition.filter(|w| w.degraded(self.kin.pivot_ratio())) {
+            let degraded = partition
+                .as_mut()
+                .filter(|w| w.degraded(self.kin.pivot_ratio()));
+            if let Some(chosen) = degraded.map(|w| w.quality(self)) {
                 let log = &mut traj.partition_switches;
-                if let Some((q1, qd1)) = self.switch_partition(t, &q, &qd, w.quality, &[], log)? {
+                if let Some((q1, qd1)) = self.switch_partition(t, &q, &qd, chosen, &[], log)? {
                     (q, qd) = (q1, qd1);
                     partition = self.partition_watch();
                 } else if let Some(w) = &mut partition {
@@ -878,7 +882,7 @@ impl Dynamics {
                     |e| integration_error(&mech, StateLayout::FirstOrder, e),
                 );
                 let watch = sys.watch.expect("set above");
-                *partition = watch.partition;
+                *partition = watch.partition.clone();
                 let (stats, stopped) = match run {
                     Ok(r) => r,
                     Err(e @ DynamicsError::Integration { .. }) => {
@@ -919,7 +923,7 @@ impl Dynamics {
                     },
                 );
                 sys.dy.kin.set_stop(None);
-                *partition = sys.watch.partition;
+                *partition = sys.watch.partition.clone();
                 let sol = match solved {
                     Ok(sol) => sol,
                     // the start-up mass matrix is singular: the projection's

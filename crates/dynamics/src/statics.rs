@@ -750,10 +750,13 @@ impl Dynamics {
                 // 180° from where it was chosen): q in the new set and
                 // chart, the same configuration
                 let rest = vec![0.0; n_q];
-                if let Some(w) = partition.filter(|w| w.degraded(self.kin.pivot_ratio())) {
+                let degraded = partition
+                    .as_mut()
+                    .filter(|w| w.degraded(self.kin.pivot_ratio()));
+                if let Some(chosen) = degraded.map(|w| w.quality(self)) {
                     let q_here = q.clone();
                     let log = &mut partition_switches;
-                    match self.switch_partition(t, &q_here, &rest, w.quality, &held_slots, log)? {
+                    match self.switch_partition(t, &q_here, &rest, chosen, &held_slots, log)? {
                         Some((q1, _)) => {
                             // a static solve logs the load factor
                             if let Some(sw) = partition_switches.last_mut() {

@@ -58,6 +58,10 @@ pub struct SweepPoint {
     /// [`SweepParameter::Path`], in their order), from the static
     /// out-of-balance at the equilibrium; empty for a load sweep.
     pub holding: Vec<f64>,
+    /// The nodal coordinates of the equilibrium (the configuration the
+    /// static solve converged to: a position solve from q alone, from
+    /// another starting guess, can land on another branch).
+    pub x: Vec<f64>,
     /// Undamped eigenfrequencies (Hz).
     pub frequencies_hz: Vec<f64>,
     /// Mode shapes (if kept), in the DOFs of [`q`](Self::q).
@@ -222,6 +226,13 @@ pub fn sweep_until(
         };
         if guess.is_some() && !matches!(solved, Ok(_) | Err(DynamicsError::Interrupted)) {
             recent.clear();
+            // from the last equilibrium's own configuration: the failed
+            // attempt left the position solve where it failed, from which q
+            // can be solved onto a flipped branch
+            if let Some(x) = xs.last() {
+                let x: &Vec<f64> = x;
+                dy.kinematics_mut().set_guess(x);
+            }
             solved = dy.static_equilibrium(opts.t, &q, &so);
         }
         if i > 0
@@ -322,6 +333,7 @@ pub fn sweep_until(
                 s: opts.values[i],
                 q,
                 holding: holding[i].clone(),
+                x: xs[i].clone(),
                 frequencies_hz: modes.frequencies_hz(),
                 modes: opts.keep_vectors.then(|| modes.vectors.clone()),
                 mass: opts.keep_vectors.then_some(m),

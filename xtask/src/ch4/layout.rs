@@ -268,13 +268,18 @@ impl Hinge {
         add(self.axis_point, self.kind.attachment_offset(), self.u_out)
     }
 
-    /// The in-plane directions of its two sheet planes: ±45° about the
-    /// bisector of `u_in` and `u_out` (its sheets cross at 90° on the axis).
-    /// The first holds the main (and outer) sheets, the second the cross
-    /// sheets (or the wire).
+    /// The in-plane directions of its two sheet planes, crossing at 90° on
+    /// the axis. A five-sheet hinge: ±45° about the bisector of `u_in` and
+    /// `u_out`, the first holding the main and outer sheets, the second the
+    /// cross sheets. A wire–sheet hinge: the sheet along the CrossBar, the
+    /// wire across it, so that the sheet's torsion lets the CrossBar twist
+    /// about its axis (thesis §4.1.3, Fig. 4.5).
     pub fn sheet_directions(&self) -> (V3, V3) {
         let b = unit(add(self.u_in, 1.0, self.u_out));
-        (turned(b, 45.0), turned(b, -45.0))
+        match self.kind {
+            HingeKind::WireSheet => (b, turned(b, 90.0)),
+            _ => (turned(b, 45.0), turned(b, -45.0)),
+        }
     }
 }
 
@@ -453,7 +458,8 @@ mod tests {
     }
 
     /// Each hinge's boundary nodes are on the members' axes and its sheet
-    /// planes cross at 90° on the axis, symmetric about the bisector.
+    /// planes cross at 90° on the axis; a wire–sheet hinge's sheet is along
+    /// the CrossBar.
     #[test]
     fn hinge_nodes_and_sheets_are_placed_symmetrically() {
         let l = Layout::new();
@@ -461,6 +467,13 @@ mod tests {
             let (s1, s2) = h.sheet_directions();
             let dot = s1[0] * s2[0] + s1[1] * s2[1];
             assert!(dot.abs() < 1e-12, "{}", h.id);
+            if h.kind == HingeKind::WireSheet {
+                assert!(
+                    norm(sub(s1, unit(l.d))) < 1e-12,
+                    "{}: the sheet along the CrossBar",
+                    h.id
+                );
+            }
             let c = h.kind.attachment_offset();
             assert!((norm(sub(h.node_a(), h.axis_point)) - c).abs() < 1e-15);
             assert!((norm(sub(h.node_b(), h.axis_point)) - c).abs() < 1e-15);

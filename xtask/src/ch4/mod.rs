@@ -10,6 +10,7 @@ pub mod layout;
 pub mod parts;
 pub mod path;
 pub mod scene;
+pub mod sweep;
 
 use layout::{HingeKind, Layout, Member};
 use rayon::prelude::*;
@@ -32,6 +33,8 @@ pub struct PartBuild {
 
 /// The scene's file name.
 pub const SCENE_FILE: &str = "two_dof_mechanism.ron";
+/// The scene with chapter 7's actuator hinges.
+pub const ACTUATED_SCENE_FILE: &str = "two_dof_mechanism_actuated.ron";
 /// The skeleton with the releases (exactly constrained).
 pub const SKELETON_FILE: &str = "two_dof_skeleton.ron";
 /// The skeleton without the releases (nine times over-constrained).
@@ -102,8 +105,15 @@ pub fn write_model(dir: &Path, progress: &(dyn Fn(&str) + Sync)) -> Result<Vec<P
         std::fs::write(dir.join(name), text).map_err(|e| format!("{name}: {e}"))
     };
     write(SCENE_FILE, scene::full_scene(&layout))?;
-    write(SKELETON_FILE, scene::skeleton(&layout, true))?;
-    write(SKELETON_RIGID_FILE, scene::skeleton(&layout, false))?;
+    write(ACTUATED_SCENE_FILE, scene::actuated_scene(&layout))?;
+    write(
+        SKELETON_FILE,
+        scene::skeleton(&layout, scene::Releases::ALL),
+    )?;
+    write(
+        SKELETON_RIGID_FILE,
+        scene::skeleton(&layout, scene::Releases::NONE),
+    )?;
     Ok(builds)
 }
 

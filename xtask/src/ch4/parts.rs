@@ -7,8 +7,8 @@
 //! thin-walled aluminium box with 1 mm walls and solid steel flexure
 //! attachment blocks at its ends, the interfaces; the lower arms with a
 //! steel T-profile (torsion release) and notch (out-of-plane bending
-//! release) before their end-effector end (Fig. 4.4); the CrossBar all
-//! steel, with notches at both ends (Fig. 4.5); the end-effector an
+//! release) before their end-effector end (Fig. 4.4); the CrossBar a
+//! solid steel bar with notches at both ends (Fig. 4.5); the end-effector an
 //! aluminium block (a rigid superelement). Point masses on rigid links stand
 //! for the actuator coils and encoders. Every part is meshed along x (its
 //! length), width along y, height along z, and placed in the mechanism by
@@ -77,7 +77,9 @@ pub const SPACER: f64 = 0.005;
 /// Thickness of notches, flanges and webs (m).
 pub const RELEASE_THICKNESS: f64 = 0.002;
 
-/// The CrossBar's section (m): a solid steel bar 10 mm wide, 20 mm high.
+/// The CrossBar's section (m): a solid steel bar 10 mm wide, 20 mm high
+/// (its twist about its axis, on the torsion of the wire–sheet hinges'
+/// sheets, is the internal mode of §4.1.3, which the thesis finds third).
 pub const CROSSBAR_SECTION: [f64; 2] = [0.010, 0.020];
 
 /// The end-effector block (m): 60 mm wide, 20 mm high.

@@ -3,7 +3,8 @@
 //! boundary nodes, each cross-hinge as its sheets (3 beams each, or 3
 //! superelements with warping for the main sheets of the elbows and of the
 //! CrossBar hinges) clamped by rigid beams to the boundary nodes on either
-//! side (Fig. 4.11), the CrossBar joined to the upper X arms by rigid beams
+//! side (Fig. 4.11; the wires of the CrossBar hinges as trusses,
+//! [`SceneText::wire`]), the CrossBar joined to the upper X arms by rigid beams
 //! (Fig. 4.10), and the end-effector a rigid superelement with a massless
 //! rigid beam to its third hinge (Fig. 4.7).
 //!
@@ -94,28 +95,33 @@ impl SceneText {
     }
 
     /// A flexible beam chain of `n` from `p` to `q` (steel, section `sec`,
-    /// local y along `up`), its elongation rigid if `rigid_elongation` (a
-    /// flexure's axial stiffness puts those modes far above the 200 Hz of
-    /// interest; SPACAR models of flexures keep it rigid, as the chapter-6
-    /// guidance does, where that over-constrains nothing).
-    #[allow(clippy::too_many_arguments)]
-    pub fn flexure(
-        &mut self,
-        id: &str,
-        p: &str,
-        q: &str,
-        sec: &str,
-        up: V3,
-        n: usize,
-        rigid_elongation: bool,
-    ) {
+    /// local y along `up`), every deformation flexible: with the
+    /// elongations free the model has the thesis's 688 degrees of freedom
+    /// (with beams for the wires), and three coplanar sheets of a hinge with
+    /// rigid elongations would over-constrain it (three parallel length
+    /// constraints in one plane have rank two).
+    pub fn flexure(&mut self, id: &str, p: &str, q: &str, sec: &str, up: V3, n: usize) {
         self.elements.push(format!(
             r#"(id: "{id}", type: Beam((nodes: ("{p}", "{q}"), material: "steel", section: "{sec}", up: Some({}), n: {n})))"#,
             v(up)
         ));
-        if rigid_elongation {
-            self.rigid.push(format!(r#"Def("{id}", "elongation")"#));
-        }
+    }
+
+    /// A wire flexure from `p` to `q` as one truss (steel, Table 4.2's
+    /// diameter): its axial constraint, without the bending stiffness of the
+    /// thesis's three beams, which is four orders of magnitude below the
+    /// sheet's next to it (EI/L = 0.013 N m against 130 N m) and whose
+    /// near-singular bending and torsion DOFs made the static Newton
+    /// iteration along the path take 2–4× the iterations (measured: 26–48
+    /// against 15–29 per point).
+    pub fn wire(&mut self, id: &str, p: &str, q: &str) {
+        let area = std::f64::consts::PI * 0.25 * WIRE_DIAMETER * WIRE_DIAMETER;
+        let (e, rho) = (2.1e11, 7800.0);
+        self.elements.push(format!(
+            r#"(id: "{id}", type: Truss(nodes: ("{p}", "{q}"), ea: {:?}, mass_per_length: {:?}))"#,
+            e * area,
+            rho * area
+        ));
     }
 
     /// A massless rigid beam from `p` to `q`: a rigid interconnection of the
@@ -274,7 +280,6 @@ pub fn hinge_sections(st: &mut SceneText) {
             );
         }
     }
-    st.section("wire", &format!("Circle(d: {WIRE_DIAMETER:?})"));
     st.section("rigid", "Rectangle(by: 0.01, bz: 0.01)");
 }
 
@@ -325,14 +330,10 @@ pub fn add_hinge(st: &mut SceneText, h: &Hinge) {
         st.node(&ea, add(base, -len, dir));
         st.node(&eb, add(base, len, dir));
         let id = format!("{}.{tag}", h.id);
-        // coplanar sheets with rigid elongations over-constrain the hinge
-        // (three parallel length constraints in one plane have rank two):
-        // the outer sheets, coplanar with the main one, keep theirs
-        let rigid_elongation = !tag.starts_with("outer");
         match kind {
-            Flexure::Beams(sec) => st.flexure(&id, &ea, &eb, &sec, Z, PER_SHEET, rigid_elongation),
+            Flexure::Beams(sec) => st.flexure(&id, &ea, &eb, &sec, Z, PER_SHEET),
             Flexure::Superelements => sheet_superelements(st, &id, &ea, &eb, h.kind),
-            Flexure::Wire => st.flexure(&id, &ea, &eb, "wire", Z, PER_SHEET, true),
+            Flexure::Wire => st.wire(&id, &ea, &eb),
         }
         st.rigid_beam(&format!("{}.{tag}.clamp_a", h.id), &na, &ea);
         st.rigid_beam(&format!("{}.{tag}.clamp_b", h.id), &eb, &nb);
@@ -368,7 +369,7 @@ enum Flexure {
     Beams(String),
     /// Three superelements with warping.
     Superelements,
-    /// The wire: three beams of the wire section.
+    /// The wire: one truss ([`SceneText::wire`]).
     Wire,
 }
 
@@ -376,7 +377,38 @@ enum Flexure {
 /// (chapter 4 leaves gravity out of the eigenvalue analyses): the text, to be
 /// written as `two_dof_mechanism.ron` next to the part files of [`DIR`].
 pub fn full_scene(layout: &Layout) -> String {
+    scene_text(layout, false)
+}
+
+/// The actuator hinges of thesis §7.2.1 and their ground nodes: (hinge,
+/// ground node, the base hinge whose B node is the arm's first node).
+pub const ACTUATORS: [(&str, &str, &str); 2] = [
+    ("act_x", "act_x.ground", "hb_x1"),
+    ("act_y", "act_y.ground", "hb_y"),
+];
+
+/// The full scene with the actuator hinges of chapter 7 (§7.2.1): between
+/// the fixed world and UpperArmX1, and between it and UpperArmY, axes along
+/// z, at the arms' base hinge axes, with zero stiffness and their bending
+/// deformations free, so that they neither stiffen nor constrain the arm;
+/// their rotations `act_x.rotation` and `act_y.rotation` are the
+/// co-located sensors φx, φy, and the PD controllers (7.12) act on them.
+pub fn actuated_scene(layout: &Layout) -> String {
+    scene_text(layout, true)
+}
+
+fn scene_text(layout: &Layout, actuated: bool) -> String {
     let mut st = SceneText::default();
+    if actuated {
+        for (hinge, ground, base) in ACTUATORS {
+            st.node(ground, layout.hinge(base).axis_point);
+            st.fix(format!(r#"Node("{ground}")"#));
+            st.element(format!(
+                r#"(id: "{hinge}", type: Hinge(nodes: ("{ground}", "{base}.B"), axis: Some({}), stiffness: 0.0, bending_stiffness: 0.0))"#,
+                v(Z)
+            ));
+        }
+    }
     hinge_sections(&mut st);
     for h in &layout.hinges {
         add_hinge(&mut st, h);
@@ -434,21 +466,48 @@ pub fn full_scene(layout: &Layout) -> String {
     st.rigid_beam("ee_link_x2", "EE.q", &node("hf_x2", true));
     st.rigid_beam("ee_link_y", END_EFFECTOR_NODE, &node("hf_y", true));
     st.finish(
-        "Two-DOF large-stroke compliant mechanism, a substitute of thesis ch. 4 (Fig. 4.6)",
+        if actuated {
+            "Two-DOF large-stroke compliant mechanism with the actuator hinges of thesis ch. 7 (§7.2.1)"
+        } else {
+            "Two-DOF large-stroke compliant mechanism, a substitute of thesis ch. 4 (Fig. 4.6)"
+        },
         &format!("    dofs: Deformations,\n    outputs: [Position(\"{END_EFFECTOR_NODE}\")],\n"),
     )
 }
 
+/// Which releases of thesis §4.1.3 a [`skeleton`] has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Releases {
+    /// The lower arms' torsion (T-profile) and out-of-plane bending
+    /// (notch) releases.
+    pub lower_arms: bool,
+    /// The CrossBar's notches and the torsion of its wire–sheet hinges.
+    pub crossbar: bool,
+}
+
+impl Releases {
+    /// Every release: exactly constrained.
+    pub const ALL: Releases = Releases {
+        lower_arms: true,
+        crossbar: true,
+    };
+    /// None: nine times over-constrained.
+    pub const NONE: Releases = Releases {
+        lower_arms: false,
+        crossbar: false,
+    };
+}
+
 /// The kinematic skeleton of thesis §4.1.3: rigid members (rigid beams
 /// between the hinge axes) and ideal revolute cross-hinges about z; with
-/// `releases`, the lower arms' torsion and out-of-plane bending releases
-/// (ideal hinges about the arm and about the in-plane normal, at 85 % of the
-/// arm) and the CrossBar's notches and wire–sheet hinges (at each end a
-/// hinge about z, one about the sheet's direction and one about the
-/// in-plane normal: a spherical joint). Without them it is nine times
-/// over-constrained; with them exactly constrained with mobility 3: the two
-/// DOFs and the CrossBar's twist.
-pub fn skeleton(layout: &Layout, releases: bool) -> String {
+/// `releases.lower_arms`, the lower arms' torsion and out-of-plane bending
+/// releases (ideal hinges about the arm and about the in-plane normal, at
+/// 85 % of the arm); with `releases.crossbar`, the CrossBar's notches and
+/// wire–sheet hinges (at each end a hinge about z, one about the sheet's
+/// direction and one about the in-plane normal: a spherical joint). Without
+/// releases it is nine times over-constrained; with all of them exactly
+/// constrained with mobility 3: the two DOFs and the CrossBar's twist.
+pub fn skeleton(layout: &Layout, releases: Releases) -> String {
     let mut st = SceneText::default();
     st.section("rigid", "Rectangle(by: 0.01, bz: 0.01)");
     let at = |id: &str| layout.hinge(id).axis_point;
@@ -464,7 +523,7 @@ pub fn skeleton(layout: &Layout, releases: bool) -> String {
         st.hinge(id, a, b, axis, true);
     };
     for h in &layout.hinges {
-        if h.kind == HingeKind::WireSheet && releases {
+        if h.kind == HingeKind::WireSheet && releases.crossbar {
             // z, then the sheet's direction, then the in-plane normal to
             // the CrossBar (the notch), through intermediate nodes
             let (s1, _) = h.sheet_directions();
@@ -503,7 +562,7 @@ pub fn skeleton(layout: &Layout, releases: bool) -> String {
         ("LowerArmY", "he_y", "hf_y"),
     ] {
         let (a, b) = (format!("{from}.B"), format!("{to}.A"));
-        if releases {
+        if releases.lower_arms {
             let u = unit(sub(at(to), at(from)));
             let r = add(at(from), 0.85, sub(at(to), at(from)));
             let (r0, r1, r2) = (
@@ -526,10 +585,13 @@ pub fn skeleton(layout: &Layout, releases: bool) -> String {
     link(&mut st, "EndEffector", "hf_x1.B", "hf_x2.B");
     link(&mut st, "EndEffector_y", "hf_x1.B", "hf_y.B");
     st.finish(
-        if releases {
-            "Kinematic skeleton of the ch. 4 mechanism, with the releases of §4.1.3"
-        } else {
-            "Kinematic skeleton of the ch. 4 mechanism, without releases"
+        match (releases.lower_arms, releases.crossbar) {
+            (true, true) => {
+                "Kinematic skeleton of the ch. 4 mechanism, with the releases of §4.1.3"
+            }
+            (false, false) => "Kinematic skeleton of the ch. 4 mechanism, without releases",
+            (true, false) => "Kinematic skeleton of the ch. 4 mechanism, lower-arm releases only",
+            (false, true) => "Kinematic skeleton of the ch. 4 mechanism, CrossBar releases only",
         },
         "",
     )
