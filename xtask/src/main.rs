@@ -126,7 +126,11 @@ fn main() -> ExitCode {
         }
         Cmd::Mechanism4 { out } => mechanism4(out.unwrap_or_else(xtask::ch4::fixture_dir)),
         Cmd::Hinge4 { out } => {
-            let out = if out.is_absolute() { out } else { root.join(out) };
+            let out = if out.is_absolute() {
+                out
+            } else {
+                root.join(out)
+            };
             xtask::ch4::hinge_check::write_report(&root, &out)
         }
         Cmd::Regress { update, chapter } => {

@@ -9,27 +9,86 @@
 //! 4: one base cross-hinge against CalculiX").
 
 use xtask::ch4::hinge_check::{
-    mechanism, read_solid, scene_text, Comparison, SheetModel, HEAD, HINGE, MODELS, SOLID,
+    mechanism, read_solid, scene_text, Comparison, SheetModel, HEAD, HINGE, MODELS,
 };
 
-/// The solid's own discretization error, from its mesh study (coarse
-/// 12 × 8/4/3 × 2 against the stored 25 × 16/8/5 × 2 elements).
-const COARSE: &str = "fixtures/curves/solid/hinge_base_nu0_12x8x4x3x2";
-
+/// Tolerances, from the measured deviations (docs/reproduce.md) and the
+/// solid's own error:
+/// - M at the solid's angles, 1 %: measured at most 0.70 % (all models);
+///   the solid's Newton tolerance leaves its M uncertain by 0.1–0.5 % (two
+///   decks through the same ϕ disagree by that much).
+/// - secant stiffness ΔM/Δϕ over the 5° intervals, 2.5 %: measured at most
+///   1.82 %; the solid's 0.5 % in M over 5° is 1–2 % of the secant.
+/// - B's x displacement, 1e-4: measured 8e-6 (it follows from ϕ, matched to
+///   1e-7 rad, and the hinge's centre of rotation).
+/// - f1, 0.6 %: measured at most 0.46 %; the coarse solid mesh moves the
+///   solid's f1 by up to 0.57 % at ±20°.
+/// - f2 … f6 of the warping beams, 0.3 %: measured at most 0.19 %
+///   (n = 20: 0.14 %); the solid's mesh moves them by at most 0.09 %.
+/// - the St-Venant beams' (the mechanism's 3 and 10 per sheet) torsion-laden
+///   f6 at 10–20°: 15–35 % low (measured −21.4 % and −30.0 %), the claim of
+///   docs/reproduce.md that restrained warping, which they lack, stiffens it.
 #[test]
 fn the_base_hinge_against_the_solid() {
     let root = xtask::workspace_root();
     let c = Comparison::compute(&root).unwrap();
-    let mut figs = xtask::report::Figures::default();
-    let out = std::env::temp_dir().join(format!("flexmb-ch4-hinge-{}", std::process::id()));
-    std::fs::create_dir_all(&out).unwrap();
-    eprintln!("{}", c.section(&mut figs, &out).unwrap());
-    let _ = std::fs::remove_dir_all(&out);
     let d: Vec<_> = (0..MODELS.len()).map(|k| c.deviations(k)).collect();
     for (m, d) in MODELS.iter().zip(&d) {
         eprintln!("{}: {d:?}", m.label());
+        assert!(
+            d.moment.abs() <= 0.01,
+            "{}: M off by {}",
+            m.label(),
+            d.moment
+        );
+        assert!(
+            d.slope.abs() <= 0.025,
+            "{}: ΔM/Δϕ off by {}",
+            m.label(),
+            d.slope
+        );
+        assert!(
+            d.shift.abs() <= 1e-4,
+            "{}: u_x off by {}",
+            m.label(),
+            d.shift
+        );
+        assert!(
+            d.freqs[0].abs() <= 0.006,
+            "{}: f1 off by {}",
+            m.label(),
+            d.freqs[0]
+        );
     }
-    todo!("tolerances from the measured numbers");
+    let warping = MODELS
+        .iter()
+        .position(|m| matches!(m, SheetModel::WarpingBeams(_)))
+        .unwrap();
+    for (j, f) in d[warping].freqs.iter().enumerate().skip(1) {
+        assert!(f.abs() <= 0.003, "warping beams: f{} off by {f}", j + 1);
+    }
+    for (k, m) in MODELS.iter().enumerate() {
+        if k != warping {
+            let f6 = d[k].freqs[5];
+            assert!(
+                (-0.35..=-0.15).contains(&f6),
+                "{}: f6 off by {f6}",
+                m.label()
+            );
+        }
+    }
+    // the solid's mesh study: the stored solid is converged to well within
+    // the tolerances above
+    let (phi, f) = c.solid.change_to(&c.coarse).unwrap();
+    assert!(phi.abs() <= 1e-3, "{phi}");
+    assert!(f.iter().all(|v| v.abs() <= 0.006), "{f:?}");
+    // the report section and its figures are written
+    let mut figs = xtask::report::Figures::default();
+    let out = std::env::temp_dir().join(format!("flexmb-ch4-hinge-{}", std::process::id()));
+    std::fs::create_dir_all(&out).unwrap();
+    let md = c.section(&mut figs, &out).unwrap();
+    assert!(md.contains("warping beams, n = 10") && out.join("hinge_f6.svg").exists());
+    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// The check's hinge is the mechanism's `hb_x1`: every node of the hinge
@@ -58,9 +117,9 @@ fn the_hinge_is_the_mechanisms_own() {
     assert_eq!(sheets(&check), sheets(&full));
 }
 
-/// What the models are: the mechanism's own keeps the rigid elongations
-/// of the main and cross sheets, the converged and warping models free
-/// them; the warping model adds one coordinate per inner node.
+/// What the models are: the mechanism's own is 3 beams per sheet with
+/// their elongations free (as `Beams(3)`); the warping model adds one
+/// warping coordinate per inner node of each sheet.
 #[test]
 fn the_models_have_the_expected_degrees_of_freedom() {
     let dofs = |m| mechanism(m, HEAD).unwrap().n_dof();
@@ -69,11 +128,12 @@ fn the_models_have_the_expected_degrees_of_freedom() {
         dofs(SheetModel::Beams(3)),
         dofs(SheetModel::WarpingBeams(3)),
     );
-    // the main and two cross sheets' rigid elongations, 3 beams each (the
-    // outer sheets keep theirs free: coplanar with the main sheet, rigid
-    // ones would over-constrain the hinge)
-    assert_eq!(beams3 - mech, 9);
-    assert_eq!(warp3 - beams3, 5 * 2, "two inner warping coordinates per sheet");
+    assert_eq!(beams3, mech);
+    assert_eq!(
+        warp3 - beams3,
+        5 * 2,
+        "two inner warping coordinates per sheet"
+    );
 }
 
 /// A solid file with a malformed row is refused with its name and line.
@@ -90,5 +150,4 @@ fn a_malformed_solid_is_refused_naming_the_file_and_line() {
     let e = read_solid(&dir, "bad").unwrap_err();
     assert!(e.contains("bad.csv:4:"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
-    let _ = (COARSE, SOLID);
 }

@@ -20,12 +20,12 @@
 use super::layout::{add, Layout, V3, Z};
 use super::scene::{add_hinge, boundary_nodes, hinge_sections, SceneText};
 use crate::models::NodeProbe;
+use crate::report::{pct, sig, Figures, Table};
 use crate::solid6::{read_numeric_rows, read_solid_points};
 use flexmb_dynamics::Dynamics;
 use flexmb_model::{ElementSpec, Mechanism, Scene, Select, WarpingEnd, WarpingSpec};
-use flexmb_reduction::MechanicalModel;
-use crate::report::{pct, sig, Figures, Table};
 use flexmb_plot::{Plot, Series};
+use flexmb_reduction::MechanicalModel;
 use std::fmt::Write;
 use std::path::Path;
 use std::sync::Arc;
@@ -277,10 +277,7 @@ pub fn states_at(
     let mut dy = Dynamics::new(mech.clone());
     let ctx = |e: flexmb_reduction::ReductionError| format!("{}: {e}", model.label());
     // the solid's force: M = F·2x cos ϕ for a couple at (±x, y) turned by ϕ
-    let mut lam: Vec<f64> = at
-        .iter()
-        .map(|s| s.m / (MOMENT * s.phi.cos()))
-        .collect();
+    let mut lam: Vec<f64> = at.iter().map(|s| s.m / (MOMENT * s.phi.cos())).collect();
     let mut worst = f64::INFINITY;
     for _ in 0..MAX_PASSES {
         let mut all = Vec::with_capacity(3 * lam.len());
@@ -340,6 +337,11 @@ const MAX_PASSES: usize = 6;
 /// and frequencies) and `STEM_curve.csv` (every load increment).
 pub const SOLID: &str = "fixtures/curves/solid/hinge_base_nu0_25x16x8x5x2";
 
+/// The same solid on a coarser mesh (12 × 8/4/3 × 2 elements: along the
+/// length; the main, cross and outer sheets' heights; the thickness), at
+/// the same moments: the stored solid's own discretization error.
+pub const COARSE: &str = "fixtures/curves/solid/hinge_base_nu0_12x8x4x3x2";
+
 /// The solid: per deck its state and frequencies, and the states of every
 /// load increment (the moment–angle curve), sorted by ϕ.
 #[derive(Clone, Debug)]
@@ -378,59 +380,55 @@ pub fn read_solid(root: &Path, stem: &str) -> Result<SolidHinge, String> {
 }
 
 impl SolidHinge {
-    /// The slope dM/dϕ of the solid's curve at `phi` (rad): the least-squares
-    /// quadratic through the increments within [`SLOPE_WINDOW`] of it (at
-    /// least three, or `None`).
-    pub fn slope_at(&self, phi: f64) -> Option<f64> {
-        let near: Vec<(f64, f64)> = self
-            .curve
-            .iter()
-            .filter(|s| (s.phi - phi).abs() <= SLOPE_WINDOW)
-            .map(|s| (s.phi - phi, s.m))
+    /// The largest relative change from `self` to `other` (the same decks on
+    /// another mesh) of ϕ (away from 0) and of f1 … f[`MODES`]: (ϕ, per mode).
+    pub fn change_to(&self, other: &SolidHinge) -> Result<(f64, Vec<f64>), String> {
+        if self.points.len() != other.points.len() {
+            return Err("the two solids have different decks".into());
+        }
+        let pairs = || self.points.iter().zip(&other.points);
+        let phi = largest(
+            pairs()
+                .filter(|(a, _)| a.0.phi.abs() > 1e-6)
+                .map(|(a, b)| b.0.phi / a.0.phi - 1.0),
+        );
+        let f = (0..MODES)
+            .map(|j| largest(pairs().map(|(a, b)| b.1[j] / a.1[j] - 1.0)))
             .collect();
-        if near.len() < 3 {
-            return None;
-        }
-        // normal equations of m ≈ a + b d + c d²
-        let mut n = [[0.0f64; 3]; 3];
-        let mut r = [0.0f64; 3];
-        for (d, m) in &near {
-            let v = [1.0, *d, d * d];
-            for i in 0..3 {
-                r[i] += v[i] * m;
-                for j in 0..3 {
-                    n[i][j] += v[i] * v[j];
-                }
-            }
-        }
-        solve3(n, r).map(|x| x[1])
+        Ok((phi, f))
+    }
+
+    /// The secant stiffness ΔM/Δϕ (N m/rad) between consecutive decks'
+    /// final states, with the interval's mid-angle (rad). The solid's
+    /// increment-to-increment slopes are no stiffness measure: its Newton
+    /// tolerance leaves M uncertain by about 0.1–0.5 % (two decks through
+    /// the same ϕ disagree by that much), which over one 1.25° increment is
+    /// ±10 % of the slope (docs/reproduce.md).
+    pub fn secants(&self) -> Vec<(f64, f64)> {
+        secants(self.points.iter().map(|p| &p.0))
     }
 }
 
-/// Half the width of the window of the solid's slope fit (rad): 1.6°, a
-/// little more than one load increment of its decks (about 1.25°).
-pub const SLOPE_WINDOW: f64 = 1.6 * std::f64::consts::PI / 180.0;
-
-/// x with a x = r for a 3 × 3 matrix (Cramer's rule), `None` if singular.
-fn solve3(a: [[f64; 3]; 3], r: [f64; 3]) -> Option<[f64; 3]> {
-    let det = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(&a);
-    if d.abs() <= 1e-300 {
-        return None;
-    }
-    Some(std::array::from_fn(|k| {
-        let mut m = a;
-        for i in 0..3 {
-            m[i][k] = r[i];
-        }
-        det(&m) / d
-    }))
+/// [`SolidHinge::secants`] of any states sorted by ϕ.
+fn secants<'a>(states: impl Iterator<Item = &'a HingeState>) -> Vec<(f64, f64)> {
+    let v: Vec<&HingeState> = states.collect();
+    v.windows(2)
+        .map(|w| {
+            (
+                0.5 * (w[0].phi + w[1].phi),
+                (w[1].m - w[0].m) / (w[1].phi - w[0].phi),
+            )
+        })
+        .collect()
 }
 
+impl ModelStates {
+    /// The secant stiffness between its consecutive states, as
+    /// [`SolidHinge::secants`] (the states are at the solid's angles).
+    pub fn secants(&self) -> Vec<(f64, f64)> {
+        secants(self.points.iter().map(|p| &p.0))
+    }
+}
 
 /// The frequencies compared: f1 … f6 (issue 17), in order of frequency.
 pub const MODES: usize = 6;
@@ -448,6 +446,8 @@ pub const MODELS: [SheetModel; 3] = [
 pub struct Comparison {
     /// The stored solid.
     pub solid: SolidHinge,
+    /// The same on the coarser mesh ([`COARSE`]).
+    pub coarse: SolidHinge,
     /// Each model at the solid's angles.
     pub models: Vec<ModelStates>,
 }
@@ -459,7 +459,8 @@ pub struct Comparison {
 pub struct Deviations {
     /// Of the moment M at the same ϕ.
     pub moment: f64,
-    /// Of the slope dM/dϕ (against the solid's fitted slope).
+    /// Of the secant stiffness ΔM/Δϕ between consecutive angles
+    /// ([`SolidHinge::secants`]).
     pub slope: f64,
     /// Of B's x displacement.
     pub shift: f64,
@@ -478,12 +479,17 @@ impl Comparison {
     pub fn compute(root: &Path) -> Result<Self, String> {
         use rayon::prelude::*;
         let solid = read_solid(root, SOLID)?;
+        let coarse = read_solid(root, COARSE)?;
         let at: Vec<HingeState> = solid.points.iter().map(|p| p.0.clone()).collect();
         let models = MODELS
             .par_iter()
             .map(|m| states_at(*m, &at, MODES))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Self { solid, models })
+        Ok(Self {
+            solid,
+            coarse,
+            models,
+        })
     }
 
     /// The deviations of model `k`.
@@ -494,9 +500,12 @@ impl Comparison {
         let rel = |a: f64, b: f64| a / b - 1.0;
         Deviations {
             moment: largest(away().map(|((f, _, _), (s, _))| rel(f.m, s.m))),
-            slope: largest(pairs().filter_map(|((_, k, _), (s, _))| {
-                self.solid.slope_at(s.phi).map(|ks| rel(*k, ks))
-            })),
+            slope: largest(
+                m.secants()
+                    .iter()
+                    .zip(self.solid.secants())
+                    .map(|(k, ks)| rel(k.1, ks.1)),
+            ),
             shift: largest(away().map(|((f, _, _), (s, _))| rel(f.u[0], s.u[0]))),
             freqs: (0..MODES)
                 .map(|j| largest(pairs().map(|((_, _, f), (_, fs))| rel(f[j], fs[j]))))
@@ -510,42 +519,94 @@ impl Comparison {
     pub fn section(&self, figs: &mut Figures, out: &Path) -> std::io::Result<String> {
         let mut s = String::new();
         let _ = writeln!(s, "## One base cross-hinge against CalculiX (issue 17)\n");
-        let _ = writeln!(s, "The base hinge `{HINGE}` of the mechanism (Table 4.3: five sheets L = 50 mm, t = 0.5 mm, heights 10/15/33/15/10 mm), side A clamped, side B carrying a massless L-shaped link with {} kg at {} m along the hinge's line and {} m below, turned about z by a couple. The solid is `{SOLID}.csv` (`research/ch4/hinge.py`: CalculiX C3D20R, NLGEOM static steps, then a *FREQUENCY perturbation step at each angle). Each flexmb model is brought to the solid's angles ϕ; M is the moment that holds it there, dM/dϕ the rotational stiffness (the solid's from a quadratic fit of its load increments within ±1.6°), u_x B's displacement; frequencies in order of frequency.\n", HEAD.mass, HEAD.reach, HEAD.drop);
-        let mut t = Table::new(&["model", "DOF", "time (s)", "M", "dM/dϕ", "u_x", "f1", "f2", "f3", "f4", "f5", "f6"]);
+        let _ = writeln!(s, "The base hinge `{HINGE}` of the mechanism (Table 4.3: five sheets L = 50 mm, t = 0.5 mm, heights 10/15/33/15/10 mm), side A clamped, side B carrying a massless L-shaped link with {} kg at {} m along the hinge's line and {} m below, turned about z by a couple. The solid is `{SOLID}.csv` (`research/ch4/hinge.py`: CalculiX C3D20R, NLGEOM static steps, then a *FREQUENCY perturbation step at each angle). Each flexmb model is brought to the solid's angles ϕ; M is the moment that holds it there, dM/dϕ the rotational stiffness (each model's tangent from central differences; against the solid, the secant ΔM/Δϕ between its angles), u_x B's displacement; frequencies in order of frequency.\n", HEAD.mass, HEAD.reach, HEAD.drop);
+        let mut t = Table::new(&[
+            "model", "DOF", "time (s)", "M", "ΔM/Δϕ", "u_x", "f1", "f2", "f3", "f4", "f5", "f6",
+        ]);
         for (k, m) in self.models.iter().enumerate() {
             let d = self.deviations(k);
-            let mut row = vec![m.model.label(), m.dofs.to_string(), format!("{:.1}", m.seconds)];
+            let mut row = vec![
+                m.model.label(),
+                m.dofs.to_string(),
+                format!("{:.1}", m.seconds),
+            ];
             row.extend([d.moment, d.slope, d.shift].iter().map(|v| pct(*v)));
             row.extend(d.freqs.iter().map(|v| pct(*v)));
             t.row(row);
         }
-        let _ = writeln!(s, "Largest deviation from the solid over ±20° (model/solid − 1):\n\n{}", t.render());
-        let mut header = vec!["ϕ (°)".to_string(), "M solid (N m)".into(), "dM/dϕ solid".into()];
+        let _ = writeln!(
+            s,
+            "Largest deviation from the solid over ±20° (model/solid − 1):\n\n{}",
+            t.render()
+        );
+        if let Ok((phi, f)) = self.solid.change_to(&self.coarse) {
+            let fs: Vec<String> = f.iter().map(|v| pct(*v)).collect();
+            let _ = writeln!(
+                s,
+                "The solid's own discretization error: on the coarser mesh `{COARSE}` (528 instead of 2100 C3D20R) ϕ at the same moments changes by at most {} and f1 … f6 by at most {}.\n",
+                pct(phi),
+                fs.join(", ")
+            );
+        }
+        let mut header = vec!["ϕ (°)".to_string(), "M solid (N m)".into()];
         for m in &self.models {
             header.push(format!("M, {}", m.model.label()));
-            header.push(format!("dM/dϕ, {}", m.model.label()));
+            header.push(format!("dM/dϕ (N m/rad), {}", m.model.label()));
         }
         let refs: Vec<&str> = header.iter().map(|h| h.as_str()).collect();
         let mut t = Table::new(&refs);
         for (i, (st, _)) in self.solid.points.iter().enumerate() {
-            let ks = self.solid.slope_at(st.phi);
-            let mut row = vec![format!("{:.3}", st.phi.to_degrees()), sig(st.m), ks.map(sig).unwrap_or_else(|| "–".into())];
+            let mut row = vec![format!("{:.3}", st.phi.to_degrees()), sig(st.m)];
             for m in &self.models {
                 let (f, k, _) = &m.points[i];
-                row.push(if st.phi.abs() > 1e-6 { pct(f.m / st.m - 1.0) } else { "–".into() });
-                row.push(ks.map(|ks| pct(k / ks - 1.0)).unwrap_or_else(|| "–".into()));
+                row.push(if st.phi.abs() > 1e-6 {
+                    pct(f.m / st.m - 1.0)
+                } else {
+                    "–".into()
+                });
+                row.push(sig(*k));
             }
             t.row(row);
         }
-        let _ = writeln!(s, "Moment and rotational stiffness at the solid's angles:\n\n{}", t.render());
+        let _ = writeln!(
+            s,
+            "The moment at the solid's angles (model/solid − 1) and each model's tangent stiffness dM/dϕ (central differences of its equilibria):\n\n{}",
+            t.render()
+        );
+        let mut header = vec!["ϕ interval (°)".to_string(), "ΔM/Δϕ solid (N m/rad)".into()];
+        header.extend(self.models.iter().map(|m| m.model.label()));
+        let refs: Vec<&str> = header.iter().map(|h| h.as_str()).collect();
+        let mut t = Table::new(&refs);
+        let secants: Vec<_> = self.models.iter().map(|m| m.secants()).collect();
+        for (i, (_, ks)) in self.solid.secants().iter().enumerate() {
+            let (a, b) = (&self.solid.points[i].0, &self.solid.points[i + 1].0);
+            let mut row = vec![
+                format!("{:.2} … {:.2}", a.phi.to_degrees(), b.phi.to_degrees()),
+                sig(*ks),
+            ];
+            row.extend(secants.iter().map(|k| pct(k[i].1 / ks - 1.0)));
+            t.row(row);
+        }
+        let _ = writeln!(
+            s,
+            "The secant stiffness ΔM/Δϕ between the solid's angles (model/solid − 1):\n\n{}",
+            t.render()
+        );
         for (j, name) in (0..MODES).map(|j| (j, format!("f{}", j + 1))) {
             let mut header = vec!["ϕ (°)".to_string(), format!("{name} solid (Hz)")];
             header.extend(self.models.iter().map(|m| m.model.label()));
             let refs: Vec<&str> = header.iter().map(|h| h.as_str()).collect();
             let mut t = Table::new(&refs);
             for (i, (st, fs)) in self.solid.points.iter().enumerate() {
-                let mut row = vec![format!("{:.3}", st.phi.to_degrees()), format!("{:.3}", fs[j])];
-                row.extend(self.models.iter().map(|m| pct(m.points[i].2[j] / fs[j] - 1.0)));
+                let mut row = vec![
+                    format!("{:.3}", st.phi.to_degrees()),
+                    format!("{:.3}", fs[j]),
+                ];
+                row.extend(
+                    self.models
+                        .iter()
+                        .map(|m| pct(m.points[i].2[j] / fs[j] - 1.0)),
+                );
                 t.row(row);
             }
             let _ = writeln!(s, "{name}, model/solid − 1:\n\n{}", t.render());
@@ -554,8 +615,16 @@ impl Comparison {
         let deg = |v: &[f64]| v.iter().map(|p| p.to_degrees()).collect::<Vec<_>>();
         let curve_phi: Vec<f64> = self.solid.curve.iter().map(|c| c.phi).collect();
         let curve_m: Vec<f64> = self.solid.curve.iter().map(|c| c.m).collect();
-        let mut p = Plot::new("Moment against rotation of the base cross-hinge", "rotation of B about z (°)", "moment (N m)");
-        p.push(Series::points("solid (every load increment)", &deg(&curve_phi), &curve_m));
+        let mut p = Plot::new(
+            "Moment against rotation of the base cross-hinge",
+            "rotation of B about z (°)",
+            "moment (N m)",
+        );
+        p.push(Series::points(
+            "solid (every load increment)",
+            &deg(&curve_phi),
+            &curve_m,
+        ));
         for m in &self.models {
             let phi: Vec<f64> = m.points.iter().map(|p| p.0.phi).collect();
             let mm: Vec<f64> = m.points.iter().map(|p| p.0.m).collect();
@@ -564,7 +633,11 @@ impl Comparison {
         figs.save(&p, out, "hinge_moment")?;
         let phi_s: Vec<f64> = self.solid.points.iter().map(|p| p.0.phi).collect();
         for j in 0..MODES {
-            let mut p = Plot::new(&format!("f{} of the base cross-hinge with its link", j + 1), "rotation of B about z (°)", &format!("f{} (Hz)", j + 1));
+            let mut p = Plot::new(
+                &format!("f{} of the base cross-hinge with its link", j + 1),
+                "rotation of B about z (°)",
+                &format!("f{} (Hz)", j + 1),
+            );
             let fs: Vec<f64> = self.solid.points.iter().map(|p| p.1[j]).collect();
             p.push(Series::points("solid", &deg(&phi_s), &fs));
             for m in &self.models {
@@ -586,14 +659,22 @@ impl Comparison {
         }
         s.push('\n');
         let mut row = |name: &str, st: &HingeState, k: Option<f64>, f: &[f64]| {
-            let _ = write!(s, "{name},{:.9},{:.9e},{},{:.9e},{:.9e}", st.phi.to_degrees(), st.m, k.map(|k| format!("{k:.9e}")).unwrap_or_default(), st.u[0], st.u[1]);
+            let _ = write!(
+                s,
+                "{name},{:.9},{:.9e},{},{:.9e},{:.9e}",
+                st.phi.to_degrees(),
+                st.m,
+                k.map(|k| format!("{k:.9e}")).unwrap_or_default(),
+                st.u[0],
+                st.u[1]
+            );
             for v in f.iter().take(MODES) {
                 let _ = write!(s, ",{v:.6}");
             }
             s.push('\n');
         };
         for (st, f) in &self.solid.points {
-            row("solid", st, self.solid.slope_at(st.phi), f);
+            row("solid", st, None, f);
         }
         for m in &self.models {
             for (st, k, f) in &m.points {
@@ -603,7 +684,6 @@ impl Comparison {
         s
     }
 }
-
 
 /// `cargo xtask hinge4`: the comparison with the stored solid written to
 /// `out`: `report.md` (the section), `hinge.csv` ([`Comparison::csv`]),
@@ -628,6 +708,10 @@ pub fn write_report(root: &Path, out: &Path) -> Result<(), String> {
         let text = scene(m, HEAD)?.to_ron();
         std::fs::write(out.join(format!("scene_{name}.ron")), text).map_err(io)?;
     }
-    println!("wrote {} in {:.0} s", out.join("report.md").display(), t.elapsed().as_secs_f64());
+    println!(
+        "wrote {} in {:.0} s",
+        out.join("report.md").display(),
+        t.elapsed().as_secs_f64()
+    );
     Ok(())
 }
