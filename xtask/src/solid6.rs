@@ -105,19 +105,19 @@ fn numbered_rows(path: &Path, columns: &[&str]) -> Result<Vec<(usize, Vec<f64>)>
     Ok(rows)
 }
 
+/// One point of a solid curve: its key columns and its frequencies (Hz).
+pub type KeyedFrequencies = (Vec<f64>, Vec<f64>);
+
 /// The points of a solid curve whose rows end in `columns…, mode, f_Hz`:
 /// per point its `columns` and its frequencies f1 … fk, in the order of the
 /// file. Consecutive rows with the same `columns` are one point, their modes
 /// numbered 1, 2, … in order.
-pub fn read_solid_points(
-    path: &Path,
-    columns: &[&str],
-) -> Result<Vec<(Vec<f64>, Vec<f64>)>, String> {
+pub fn read_solid_points(path: &Path, columns: &[&str]) -> Result<Vec<KeyedFrequencies>, String> {
     let mut all: Vec<&str> = columns.to_vec();
     all.extend(["mode", "f_Hz"]);
     let rows = numbered_rows(path, &all)?;
     let n = columns.len();
-    let mut points: Vec<(Vec<f64>, Vec<f64>)> = vec![];
+    let mut points: Vec<KeyedFrequencies> = vec![];
     for (line, r) in rows {
         let (key, mode, f) = (&r[..n], r[n], r[n + 1]);
         let bad = || {

@@ -74,7 +74,8 @@ pub(crate) struct SpatialInertia {
 /// entry instead ([`psd_factor_unscaled`]).
 pub(crate) fn psd_factor(a: &[f64], n: usize) -> Option<Vec<f64>> {
     let scale = (0..n).fold(0.0f64, |m, i| m.max(a[i * n + i].abs()));
-    if (0..n).any(|i| !(a[i * n + i] >= -1e-13 * scale)) {
+    // a NaN diagonal entry is refused too
+    if (0..n).any(|i| a[i * n + i].is_nan() || a[i * n + i] < -1e-13 * scale) {
         return None;
     }
     let d: Vec<f64> = (0..n).map(|i| a[i * n + i].max(0.0).sqrt()).collect();

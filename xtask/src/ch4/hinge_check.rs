@@ -8,12 +8,13 @@
 //!
 //! The flexmb models ([`SheetModel`]) are all made from the one scene that
 //! [`add_hinge`] writes, changed only where a model differs: the
-//! mechanism's own (3 beams per sheet, the main and cross sheets'
-//! elongations rigid), converged beams (n per sheet, elongations free) and
-//! beams with warping (Vlasov torsion, restrained at both clamps).
+//! mechanism's own (3 St-Venant beams per sheet), converged beams (n per
+//! sheet) and beams with warping (Vlasov torsion, restrained at both
+//! clamps); every deformation of the sheets is free in all of them.
 //!
 //! Each model is compared at the solid's angles ϕ of the B side: the moment
-//! M that holds it there and the slope dM/dϕ (the rotational stiffness), B's
+//! M that holds it there, the rotational stiffness (each model's tangent
+//! dM/dϕ; against the solid, the secant ΔM/Δϕ between its angles), B's
 //! displacement, and the eigenfrequencies of the rest linearization (E.6)
 //! about that equilibrium ([`states_at`]).
 
@@ -23,7 +24,7 @@ use crate::models::NodeProbe;
 use crate::report::{pct, sig, Figures, Table};
 use crate::solid6::{read_numeric_rows, read_solid_points};
 use flexmb_dynamics::Dynamics;
-use flexmb_model::{ElementSpec, Mechanism, Scene, Select, WarpingEnd, WarpingSpec};
+use flexmb_model::{ElementSpec, Mechanism, Scene, WarpingEnd, WarpingSpec};
 use flexmb_plot::{Plot, Series};
 use flexmb_reduction::MechanicalModel;
 use std::fmt::Write;
@@ -68,13 +69,13 @@ pub const MOMENT: f64 = 1.3;
 /// How the five sheets are modelled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SheetModel {
-    /// The mechanism's own: [`add_hinge`] unchanged (3 beams per sheet,
-    /// the main and cross sheets' elongations rigid).
+    /// The mechanism's own: [`add_hinge`] unchanged (3 beams per sheet;
+    /// the same model as `Beams(3)`).
     Mechanism,
-    /// `n` beams per sheet, elongations free.
+    /// `n` St-Venant beams per sheet.
     Beams(usize),
     /// `n` beams per sheet with warping restrained at both clamps
-    /// (docs/scene-format.md, "Beams with warping"), elongations free.
+    /// (docs/scene-format.md, "Beams with warping").
     WarpingBeams(usize),
 }
 
@@ -147,12 +148,12 @@ pub fn scene(model: SheetModel, head: Head) -> Result<Scene, String> {
         SheetModel::Beams(n) => (n, false),
         SheetModel::WarpingBeams(n) => (n, true),
     };
-    let mut sheets = vec![];
+    let mut sheets = 0;
     for e in &mut s.elements {
         if !is_sheet(e) {
             continue;
         }
-        sheets.push(e.id.clone());
+        sheets += 1;
         if let ElementSpec::Beam(b) = &mut e.kind {
             b.n = n;
             if warping {
@@ -163,12 +164,9 @@ pub fn scene(model: SheetModel, head: Head) -> Result<Scene, String> {
             }
         }
     }
-    if sheets.len() != 5 {
-        return Err(format!("expected five sheets, found {sheets:?}"));
+    if sheets != 5 {
+        return Err(format!("expected five sheets in {HINGE}, found {sheets}"));
     }
-    s.rigid.retain(
-        |r| !matches!(r, Select::Def(id, what) if what == "elongation" && sheets.contains(id)),
-    );
     Ok(s)
 }
 
