@@ -248,14 +248,14 @@ impl Reader {
 /// How closely a model is brought to each of the solid's angles (rad),
 /// 1e-6 of 5°: the static equilibria's tolerance leaves ϕ uncertain by
 /// about 1e-8 rad, below which the secant method stalls.
-const ANGLE_TOLERANCE: f64 = 1e-7;
+pub const ANGLE_TOLERANCE: f64 = 1e-7;
 
 /// The relative step of the load scale for the slope dM/dϕ by central
 /// differences, at least 0.01 in λ: the truncation error, h² times the
 /// relative change of the slope over the range (a few per cent), is about
 /// 1e-6, and the equilibria's 1e-8 rad of noise over steps of 1e-3 rad or
 /// more gives 1e-5.
-const SLOPE_STEP: f64 = 1e-2;
+pub const SLOPE_STEP: f64 = 1e-2;
 
 /// Model `model` at the solid's states `at`: the load scale that turns it
 /// to each state's angle ϕ (to [`ANGLE_TOLERANCE`]), by Newton's method
@@ -329,7 +329,7 @@ pub fn states_at(
 }
 
 /// Newton passes of [`states_at`]: two or three are needed.
-const MAX_PASSES: usize = 6;
+pub const MAX_PASSES: usize = 6;
 
 /// The stored solid reference, without the extension: `STEM.csv` (states
 /// and frequencies) and `STEM_curve.csv` (every load increment).
