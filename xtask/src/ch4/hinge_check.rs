@@ -80,6 +80,15 @@ pub enum SheetModel {
 }
 
 impl SheetModel {
+    /// Its name in file names: `mechanism`, `beams10`, `warping_beams10`.
+    pub fn slug(self) -> String {
+        match self {
+            SheetModel::Mechanism => "mechanism".into(),
+            SheetModel::Beams(n) => format!("beams{n}"),
+            SheetModel::WarpingBeams(n) => format!("warping_beams{n}"),
+        }
+    }
+
     /// Its name in the tables.
     pub fn label(self) -> String {
         match self {
@@ -629,6 +638,27 @@ impl Comparison {
             p.push(Series::line(&m.model.label(), &deg(&phi), &mm));
         }
         figs.save(&p, out, "hinge_moment")?;
+        let mut p = Plot::new(
+            "Rotational stiffness of the base cross-hinge",
+            "rotation of B about z (°)",
+            "stiffness (N m/rad)",
+        );
+        let (mid, ks): (Vec<f64>, Vec<f64>) = self.solid.secants().into_iter().unzip();
+        p.push(Series::points(
+            "solid, ΔM/Δϕ between its angles",
+            &deg(&mid),
+            &ks,
+        ));
+        for m in &self.models {
+            let phi: Vec<f64> = m.points.iter().map(|p| p.0.phi).collect();
+            let k: Vec<f64> = m.points.iter().map(|p| p.1).collect();
+            p.push(Series::line(
+                &format!("{}, dM/dϕ", m.model.label()),
+                &deg(&phi),
+                &k,
+            ));
+        }
+        figs.save(&p, out, "hinge_stiffness")?;
         let phi_s: Vec<f64> = self.solid.points.iter().map(|p| p.0.phi).collect();
         for j in 0..MODES {
             let mut p = Plot::new(
@@ -702,9 +732,8 @@ pub fn write_report(root: &Path, out: &Path) -> Result<(), String> {
     std::fs::write(out.join("report.md"), md).map_err(io)?;
     std::fs::write(out.join("hinge.csv"), c.csv()).map_err(io)?;
     for m in MODELS {
-        let name = m.label().replace([' ', ',', '=', '\'', '(', ')'], "_");
         let text = scene(m, HEAD)?.to_ron();
-        std::fs::write(out.join(format!("scene_{name}.ron")), text).map_err(io)?;
+        std::fs::write(out.join(format!("scene_{}.ron", m.slug())), text).map_err(io)?;
     }
     println!(
         "wrote {} in {:.0} s",
