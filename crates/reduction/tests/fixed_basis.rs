@@ -80,7 +80,10 @@ fn identity_basis_reproduces_the_unreduced_trajectory_and_frequencies() {
     // (measured: 72876 against 72834); the trajectories still agree far
     // below the integration tolerance (measured 2.8e-14 of 9.4e-3).
     let (a, b) = (sol.stats.rhs_evals as f64, full.stats.rhs_evals as f64);
-    assert!((a / b - 1.0).abs() <= 1e-3, "the same steps: {a} against {b}");
+    assert!(
+        (a / b - 1.0).abs() <= 1e-3,
+        "the same steps: {a} against {b}"
+    );
     let mut worst = 0.0f64;
     let mut scale = 0.0f64;
     assert_eq!(sol.len(), full.len());
