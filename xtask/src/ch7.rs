@@ -120,13 +120,20 @@ fn vectors(
     dofs: [usize; 2],
     p: &SweepPoint,
     variant: Variant,
+    r: usize,
 ) -> Result<Mat<f64>, String> {
     let n_q = mech.n_dof();
     let dir = path_direction(n_q, dofs, p.s);
     match variant {
         Variant::Unconstrained => {
             let v = p.modes.as_ref().ok_or("the sweep kept no mode shapes")?;
-            let vu = v.subcols(0, R).to_owned();
+            if v.ncols() < r {
+                return Err(format!(
+                    "the sweep kept {} mode shapes, {r} are needed",
+                    v.ncols()
+                ));
+            }
+            let vu = v.subcols(0, r).to_owned();
             // the path coordinates are DOFs: their rows of F,q are unit rows
             let f_p = Mat::from_fn(2, n_q, |i, j| if j == dofs[i] { 1.0 } else { 0.0 });
             let p_s = [dir[dofs[0]], dir[dofs[1]]];
@@ -136,7 +143,7 @@ fn vectors(
             let mut dy = Dynamics::new(mech.clone());
             dy.kinematics_mut().set_guess(&p.x);
             let lin = dy.linearize_at_rest(0.0, &p.q).map_err(|e| e.to_string())?;
-            constrained_eigenvectors(&lin.stiffness_total(), &lin.m, &dir, R - 1)
+            constrained_eigenvectors(&lin.stiffness_total(), &lin.m, &dir, r - 1)
                 .map(|(v, _)| v)
                 .map_err(|e| e.to_string())
         }
@@ -152,10 +159,11 @@ pub fn basis(
     dofs: [usize; 2],
     points: &[SweepPoint],
     variant: Variant,
+    r: usize,
 ) -> Result<InterpolatedBasis, String> {
     let vecs = points
         .par_iter()
-        .map(|p| vectors(mech, dofs, p, variant))
+        .map(|p| vectors(mech, dofs, p, variant, r))
         .collect::<Result<Vec<_>, String>>()?;
     let masses: Vec<Mat<f64>> = points
         .iter()
@@ -179,28 +187,45 @@ pub fn reduced(mech: &Arc<Mechanism>, basis: &InterpolatedBasis) -> Result<Reduc
     ReducedModel::new(mech.clone(), Box::new(basis.clone())).map_err(|e| e.to_string())
 }
 
-/// The first `count` eigenfrequencies of the reduced model at rest at each
-/// (s, η = 0) of `s_values` (the rest linearization (F.7)), in parallel.
+/// The first `count` eigenfrequencies of the reduced model at rest at the
+/// equilibria `points` of a path sweep (their s, η = 0; the rest
+/// linearization (F.7)), in parallel. Each is linearized as the unreduced
+/// one was: its holding force a dead load on the path DOFs `dofs` (else
+/// the path's curvature turns it into stiffness along s, −G,ssᵀ f), and its
+/// position solve starts from the equilibrium's own nodal coordinates
+/// (from another configuration Newton may converge to another branch:
+/// measured, from the start of the path the solves beyond s ≈ 0.19 m did).
 pub fn reduced_frequencies(
     mech: &Arc<Mechanism>,
     basis: &InterpolatedBasis,
-    s_values: &[f64],
+    points: &[SweepPoint],
+    dofs: [usize; 2],
     count: usize,
 ) -> Result<Vec<Vec<f64>>, String> {
-    let chunk = s_values
+    let chunk = points
         .len()
         .div_ceil(rayon::current_num_threads().max(1))
         .max(1);
-    let blocks: Vec<Result<Vec<Vec<f64>>, String>> = s_values
+    let n_q = mech.n_dof();
+    let blocks: Vec<Result<Vec<Vec<f64>>, String>> = points
         .par_chunks(chunk)
         .map(|block| {
             let mut m = reduced(mech, basis)?;
+            let mut load = vec![0.0; n_q];
             block
                 .iter()
-                .map(|s| {
+                .map(|p| {
                     let mut z = vec![0.0; basis_n_z(basis)];
-                    z[0] = *s;
-                    let mut f = m.frequencies_at_rest(0.0, &z).map_err(|e| e.to_string())?;
+                    z[0] = p.s;
+                    m.dynamics_mut().kinematics_mut().set_guess(&p.x);
+                    load[dofs[0]] = p.holding[0];
+                    load[dofs[1]] = p.holding[1];
+                    let (mz, kz) = m
+                        .linearize_at_rest_loaded(0.0, &z, Some(&load))
+                        .map_err(|e| format!("the reduced model at s = {}: {e}", p.s))?;
+                    let mut f = flexmb_linearize::generalized_symmetric(&kz, &mz, mz.nrows())
+                        .map_err(|e| e.to_string())?
+                        .frequencies_hz();
                     f.truncate(count);
                     Ok(f)
                 })

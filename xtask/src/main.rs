@@ -68,7 +68,7 @@ enum Cmd {
         /// Store the recomputed curves as the new fixtures instead of comparing.
         #[arg(long)]
         update: bool,
-        /// Only this chapter's curves (ch2, ch3, ch4, ch5 or ch6; default all).
+        /// Only this chapter's curves (ch2, ch3, ch4, ch5, ch6 or ch7; default all).
         #[arg(long, value_enum)]
         chapter: Option<Chapter>,
     },
@@ -272,12 +272,13 @@ fn regress(
     pg: &Progress,
 ) -> Result<(), String> {
     type Recompute = fn(&std::path::Path, &Progress) -> Result<xtask::regress::Recomputed, String>;
-    let chapters: [(Chapter, Recompute); 5] = [
+    let chapters: [(Chapter, Recompute); 6] = [
         (Chapter::Ch2, xtask::regress::recompute_ch2),
         (Chapter::Ch3, xtask::ch3::recompute),
         (Chapter::Ch4, xtask::reproduce4::recompute),
         (Chapter::Ch5, xtask::regress::recompute_ch5),
         (Chapter::Ch6, xtask::regress::recompute_ch6),
+        (Chapter::Ch7, xtask::reproduce7::recompute),
     ];
     let sets = chapters
         .iter()

@@ -10,6 +10,8 @@
 use crate::ch4::path::Path4;
 use crate::ch4::sweep;
 use crate::ch7::{self, Variant};
+use crate::curves::StoredCurve;
+use crate::models::CurvePoint;
 use crate::progress::Progress;
 use crate::report::{pct, sig, Figures, Table};
 use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions};
@@ -76,15 +78,136 @@ fn run_of(label: &str, mech: &flexmb_model::Mechanism, tr: &flexmb_dynamics::Tra
     }
 }
 
-/// Everything the report shows.
-pub struct Ch7Results {
+/// The reduced models' eigenfrequencies against the unreduced ones along
+/// the path (Figs 7.2, 7.3).
+pub struct Ch7Frequencies {
+    /// The mechanism (no gravity, no controllers) and its path DOFs.
+    pub mech: Arc<flexmb_model::Mechanism>,
+    /// The end-effector's x and y DOFs.
+    pub dofs: [usize; 2],
     /// The reference configurations.
     pub points: Vec<SweepPoint>,
     /// Wall time of their sweep (s).
     pub sweep_seconds: f64,
-    /// Per variant: wall time of the basis (s) and the reduced eigenfrequencies
-    /// at the reference configurations.
-    pub reduced: Vec<(Variant, f64, Vec<Vec<f64>>)>,
+    /// The equilibria halfway between them (beyond the thesis), empty if
+    /// not asked for.
+    pub between: Vec<SweepPoint>,
+    /// Per variant: the basis, its wall time (s), and the reduced
+    /// eigenfrequencies at the reference configurations and halfway between.
+    pub reduced: Vec<(
+        Variant,
+        InterpolatedBasis,
+        f64,
+        Vec<Vec<f64>>,
+        Vec<Vec<f64>>,
+    )>,
+}
+
+/// The reference configurations, IBM-u and IBM-c, and their eigenfrequencies
+/// at the `n_reference` reference configurations (and halfway between them
+/// if `between`).
+pub fn frequencies(
+    root: &Path,
+    n_reference: usize,
+    between: bool,
+    pg: &Progress,
+) -> Result<Ch7Frequencies, String> {
+    let (mech, dofs) = ch7::mechanism(root, false, None)?;
+    let values = ch7::reference_values(n_reference);
+    let mids: Vec<f64> = if between {
+        values.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect()
+    } else {
+        vec![]
+    };
+    let bar = pg.bar(
+        "ch7 reference configurations along the path",
+        2 * (values.len() + mids.len()) as u64,
+    );
+    let t = Instant::now();
+    let points = sweep::run(&mech, dofs, &values, ch7::R, &|d, _| bar.set(d as u64))?;
+    let sweep_seconds = t.elapsed().as_secs_f64();
+    let done = 2 * values.len() as u64;
+    let between = if mids.is_empty() {
+        vec![]
+    } else {
+        sweep::run(&mech, dofs, &mids, ch7::R, &|d, _| bar.set(done + d as u64))?
+    };
+    bar.finish();
+    let mut reduced = vec![];
+    for v in [Variant::Unconstrained, Variant::Constrained] {
+        let t = Instant::now();
+        let b = ch7::basis(&mech, dofs, &points, v, ch7::R)?;
+        let basis_seconds = t.elapsed().as_secs_f64();
+        pg.println(&format!("{} basis in {basis_seconds:.1} s", v.label()));
+        let at = ch7::reduced_frequencies(&mech, &b, &points, dofs, ch7::R)?;
+        let mid = ch7::reduced_frequencies(&mech, &b, &between, dofs, ch7::R)?;
+        reduced.push((v, b, basis_seconds, at, mid));
+    }
+    Ok(Ch7Frequencies {
+        mech,
+        dofs,
+        points,
+        sweep_seconds,
+        between,
+        reduced,
+    })
+}
+
+/// The fixture directory of the stored curves.
+pub fn curve_dir(root: &Path) -> std::path::PathBuf {
+    root.join("fixtures").join("curves").join("ch7")
+}
+
+/// The stored curves: the unreduced, IBM-u and IBM-c eigenfrequencies at the
+/// reference configurations.
+pub fn stored_curves(f: &Ch7Frequencies) -> Vec<StoredCurve> {
+    let curve = |model: &str, freqs: &dyn Fn(usize) -> Vec<f64>| {
+        let pts: Vec<CurvePoint> = f
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| CurvePoint {
+                lambda: p.s,
+                position: vec![p.s],
+                freqs: freqs(i),
+                highest: f64::NAN,
+            })
+            .collect();
+        StoredCurve::from_points(model, &pts, 0, ch7::R)
+    };
+    let mut out = vec![curve("unreduced", &|i| {
+        f.points[i].frequencies_hz[..ch7::R].to_vec()
+    })];
+    for (v, _, _, at, _) in &f.reduced {
+        out.push(curve(&v.label().to_lowercase().replace('-', "_"), &|i| {
+            at[i].clone()
+        }));
+    }
+    out
+}
+
+fn provenance(n: usize) -> Vec<String> {
+    vec![
+        "thesis §7.2.2: the two-DOF mechanism with its actuator hinges (fixtures/scenes/two_dof_mechanism_actuated.ron), no gravity".into(),
+        format!("{n} equally spaced arc lengths; x = lambda = s (m); unreduced (E.6) and IBM-u, IBM-c (F.7) at rest"),
+        "regenerate: cargo xtask regress --chapter ch7 --update".into(),
+    ]
+}
+
+/// Recomputes the stored regression curves (about a minute).
+pub fn recompute(root: &Path, pg: &Progress) -> Result<crate::regress::Recomputed, String> {
+    let f = frequencies(root, ch7::N_REFERENCE, false, pg)?;
+    Ok(crate::regress::Recomputed {
+        dir: curve_dir(root),
+        curves: stored_curves(&f),
+        provenance: provenance(ch7::N_REFERENCE),
+    })
+}
+
+/// Everything the report shows.
+pub struct Ch7Results {
+    /// The eigenfrequencies along the path.
+    pub freq: Ch7Frequencies,
     /// Closed-loop poles at s = 0: reduced IBM-u, and unreduced.
     pub poles: [Vec<flexmb_linearize::DampedMode>; 2],
     /// The closed-loop runs: IBM-u from the undeflected configuration and
@@ -110,30 +233,11 @@ fn poles(
 
 /// Runs chapter 7 (`o`), with progress on `pg`.
 pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results, String> {
-    // 1. the reference configurations (no gravity, no controllers)
-    let (mech, dofs) = ch7::mechanism(root, false, None)?;
-    let values = ch7::reference_values(o.n_reference);
-    let bar = pg.bar(
-        "ch7 reference configurations along the path",
-        2 * values.len() as u64,
-    );
-    let t = Instant::now();
-    let points = sweep::run(&mech, dofs, &values, ch7::R, &|d, _| bar.set(d as u64))?;
-    let sweep_seconds = t.elapsed().as_secs_f64();
-    bar.finish();
-    // 2. the bases and their eigenfrequencies at the reference configurations
-    let mut reduced = vec![];
-    let mut bases: Vec<(Variant, InterpolatedBasis)> = vec![];
-    for v in [Variant::Unconstrained, Variant::Constrained] {
-        let t = Instant::now();
-        let b = ch7::basis(&mech, dofs, &points, v)?;
-        let basis_seconds = t.elapsed().as_secs_f64();
-        pg.println(&format!("{} basis in {basis_seconds:.1} s", v.label()));
-        let f = ch7::reduced_frequencies(&mech, &b, &values, ch7::R)?;
-        reduced.push((v, basis_seconds, f));
-        bases.push((v, b));
-    }
-    let ibm_u = &bases[0].1;
+    // 1.-2. the reference configurations (no gravity, no controllers), the
+    // bases and their eigenfrequencies
+    let freq = frequencies(root, o.n_reference, true, pg)?;
+    let mech = freq.mech.clone();
+    let ibm_u = &freq.reduced[0].1;
     // 3. the angle references from IBM-u's kinematics with η ≡ 0
     let mut kin_model = ch7::reduced(&mech, ibm_u)?;
     let refs = ch7::angle_references(&mut kin_model, 4 * o.n_reference)?;
@@ -246,9 +350,7 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
         &tr,
     ));
     Ok(Ch7Results {
-        points,
-        sweep_seconds,
-        reduced,
+        freq,
         poles: [reduced_poles, unreduced_poles],
         runs,
         reference,
@@ -269,18 +371,35 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
     std::fs::write(out.join("report.md"), md).map_err(io)
 }
 
-/// The largest relative difference of mode k between a reduced model and
-/// the unreduced one over the reference configurations.
-pub fn mode_error(r: &Ch7Results, v: usize, k: usize) -> f64 {
-    r.points
+/// The relative differences of mode k between reduced model `v` (0: IBM-u,
+/// 1: IBM-c) and the unreduced one, at the reference configurations, or
+/// halfway between them if `between`.
+pub fn mode_errors(f: &Ch7Frequencies, v: usize, k: usize, between: bool) -> Vec<f64> {
+    let (points, reduced) = if between {
+        (&f.between, &f.reduced[v].4)
+    } else {
+        (&f.points, &f.reduced[v].3)
+    };
+    points
         .iter()
-        .zip(&r.reduced[v].2)
-        .map(|(p, f)| ((f[k] - p.frequencies_hz[k]) / p.frequencies_hz[k]).abs())
-        .fold(0.0, f64::max)
+        .zip(reduced)
+        .map(|(p, r)| ((r[k] - p.frequencies_hz[k]) / p.frequencies_hz[k]).abs())
+        .collect()
+}
+
+/// The median and the largest of `e`.
+pub fn median_and_max(e: &[f64]) -> (f64, f64) {
+    let mut e = e.to_vec();
+    e.sort_by(f64::total_cmp);
+    (
+        e.get(e.len() / 2).copied().unwrap_or(f64::NAN),
+        e.last().copied().unwrap_or(f64::NAN),
+    )
 }
 
 fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()> {
-    let s: Vec<f64> = r.points.iter().map(|p| p.s).collect();
+    let f = &r.freq;
+    let s: Vec<f64> = f.points.iter().map(|p| p.s).collect();
     for (stem, title, modes) in [
         ("fig7_2_omega1_2", "Fig. 7.2: ω1, ω2 along the path", 0..2),
         (
@@ -291,10 +410,10 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
     ] {
         let mut p = Plot::new(title, "arc length s (m)", "eigenfrequency (Hz)");
         for k in modes {
-            let u: Vec<f64> = r.points.iter().map(|p| p.frequencies_hz[k]).collect();
+            let u: Vec<f64> = f.points.iter().map(|p| p.frequencies_hz[k]).collect();
             p.push(Series::line(&format!("ω{} unreduced", k + 1), &s, &u));
-            for (v, _, f) in &r.reduced {
-                let y: Vec<f64> = f.iter().map(|f| f[k]).collect();
+            for (v, _, _, at, _) in &f.reduced {
+                let y: Vec<f64> = at.iter().map(|f| f[k]).collect();
                 p.push(Series::dashed(&format!("ω{} {}", k + 1, v.label()), &s, &y));
             }
         }
@@ -392,7 +511,7 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
     );
     let _ = writeln!(s, "## Reduction\n");
     let mut t = Table::new(&["", "thesis", "ours"]);
-    let n_q = r.points[0].q.len();
+    let n_q = r.freq.points[0].q.len();
     t.row(vec!["unreduced DOFs".into(), "688".into(), n_q.to_string()]);
     t.row(vec![
         "reduced DOFs".into(),
@@ -402,9 +521,9 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
     t.row(vec![
         "reference configurations (sweep time)".into(),
         "100".into(),
-        format!("{} ({:.1} s)", r.points.len(), r.sweep_seconds),
+        format!("{} ({:.1} s)", r.freq.points.len(), r.freq.sweep_seconds),
     ]);
-    for (v, secs, _) in &r.reduced {
+    for (v, _, secs, _, _) in &r.freq.reduced {
         t.row(vec![
             format!("{} basis", v.label()),
             "–".into(),
@@ -412,13 +531,35 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
         ]);
     }
     let _ = writeln!(s, "{}", t.render());
-    let _ = writeln!(s, "## Eigenfrequencies along the path (Figs 7.2, 7.3)\n\nThe reduced models' rest linearization (F.7) at z = (s, 0) against the unreduced one at the reference configurations (the end-effector held there, its holding force a dead load): the largest relative difference of each mode along the path.\n");
-    let mut t = Table::new(&["mode", "IBM-c", "IBM-u"]);
+    let _ = writeln!(
+        s,
+        "## Eigenfrequencies along the path (Figs 7.2, 7.3)\n\n\
+         The reduced models' rest linearization (F.7) at z = (s, 0) against the \
+         unreduced one (E.6), both with the end-effector's holding force as a dead \
+         load: the relative difference of each mode, median and largest, at the {} \
+         reference configurations (as the thesis) and at the {} equilibria halfway \
+         between them (beyond the thesis).\n",
+        r.freq.points.len(),
+        r.freq.between.len()
+    );
+    let mut t = Table::new(&[
+        "mode",
+        "IBM-c at the references",
+        "IBM-u at the references",
+        "IBM-c halfway",
+        "IBM-u halfway",
+    ]);
     for k in 0..ch7::R {
+        let cell = |v: usize, between: bool| {
+            let (m, x) = median_and_max(&mode_errors(&r.freq, v, k, between));
+            format!("{} ({})", pct(m), pct(x))
+        };
         t.row(vec![
             format!("ω{}", k + 1),
-            pct(mode_error(r, 1, k)),
-            pct(mode_error(r, 0, k)),
+            cell(1, false),
+            cell(0, false),
+            cell(1, true),
+            cell(0, true),
         ]);
     }
     let _ = writeln!(s, "{}", t.render());

@@ -303,13 +303,45 @@ impl ReducedModel {
         t: f64,
         z: &[f64],
     ) -> Result<(Mat<f64>, Mat<f64>), ReductionError> {
+        self.linearize_at_rest_loaded(t, z, None)
+    }
+
+    /// [`Self::linearize_at_rest`] with an extra dead load `f_q` on the
+    /// unreduced DOFs, such as the force that holds a held equilibrium
+    /// there ([`flexmb_linearize::SweepPoint::holding`] on its held DOFs):
+    /// it leaves the unreduced K unchanged but enters Kz through the
+    /// curvature of G, −G,zzᵀ f_q. With the holding force of an
+    /// equilibrium at a reference configuration the contraction vanishes
+    /// and Kz = G,zᵀ(K + G + N)G,z, the Ritz projection of the unreduced
+    /// stiffness whose eigenvalues bound the unreduced ones from above.
+    ///
+    /// # Errors
+    ///
+    /// As [`Self::linearize_at_rest`]; [`ReductionError::Invalid`] for an
+    /// `f_q` of other than n_q entries or with a non-finite one.
+    pub fn linearize_at_rest_loaded(
+        &mut self,
+        t: f64,
+        z: &[f64],
+        f_q: Option<&[f64]>,
+    ) -> Result<(Mat<f64>, Mat<f64>), ReductionError> {
         self.check_reduced(&[("z", z.len())])?;
         let nz = self.basis.n_z();
         self.basis
             .eval(z, &vec![0.0; nz], &mut self.q, &mut self.gz, &mut self.conv);
         let q = self.q.clone();
         let lin = self.dy.linearize_at_rest(t, &q)?;
-        let (r, _) = self.dy.static_tangent(t, &q)?;
+        let (mut r, _) = self.dy.static_tangent(t, &q)?;
+        if let Some(f) = f_q {
+            if f.len() != r.len() || f.iter().any(|v| !v.is_finite()) {
+                return Err(ReductionError::Invalid(format!(
+                    "the dead load needs {} finite entries (one per DOF), got {}",
+                    r.len(),
+                    f.len()
+                )));
+            }
+            r.iter_mut().zip(f).for_each(|(r, f)| *r -= f);
+        }
         let mz = self.gz.transpose() * &lin.m * &self.gz;
         let mut kz = self.gz.transpose() * lin.stiffness_total() * &self.gz;
         kz += &self.basis.hessian_contraction(z, &r);
