@@ -10,7 +10,7 @@ docs/reproduce.md): a flat, hollow aluminium arm along x from node 5
 wide (y) and 3.7 mm high (z) with 1 mm walls, solid 10 mm end blocks whose
 outer faces are the two interfaces, and two 1 mm bulkheads (ribs) inside at a
 third and two thirds of the tube. E = 7.0e10 Pa, nu = 0.33, rho = 2700.
-The mesh is flexmb's (research/ch3/boxmesh.py repeats its algorithm) with
+The mesh is flexmb's (research/ch3/deck.py repeats its algorithm) with
 C3D20 elements (full integration, as flexmb's built-in hexahedra), so the
 superelements and this model share their elements.
 
@@ -21,9 +21,9 @@ and its "interface surfaces modelled rigidly"). One *FREQUENCY step.
 Usage: python3 component.py [--h 0.005] [--modes 10] [--out DIR]
 Prints CSV: case,h,mode,f_Hz
 """
-import argparse, os, subprocess, sys
+import argparse, os, sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import boxmesh
+import deck
 
 X5, X6 = 0.04, 0.29
 NODE7 = (0.29, -0.1, 0.0)
@@ -48,12 +48,12 @@ def blocks():
 def part_lines(h, first_node=1, first_element=1, etype="C3D20"):
     """The part's nodes, elements, material and section, and its clamp and
     rigid-face node sets: (lines, nodes, elements, p face, q face)."""
-    nodes, elems = boxmesh.boxes(blocks(), (h, h, h), first_node, first_element)
+    nodes, elems = deck.boxes(blocks(), (h, h, h), first_node, first_element)
     out = ["*NODE"] + [f"{n},{x:.12e},{y:.12e},{z:.12e}" for n, (x, y, z) in nodes.items()]
-    out += boxmesh.element_lines(elems, etype, "ARM")
+    out += deck.element_lines(elems, etype, "ARM")
     out += [f"*MATERIAL,NAME=ALU\n*ELASTIC\n{E:.6e},{NU}\n*DENSITY\n{RHO}",
             "*SOLID SECTION,ELSET=ARM,MATERIAL=ALU"]
-    return out, nodes, elems, boxmesh.on_plane(nodes, 0, X5), boxmesh.on_plane(nodes, 0, X6)
+    return out, nodes, elems, deck.on_plane(nodes, 0, X5), deck.on_plane(nodes, 0, X6)
 
 
 def write(path, a):
@@ -65,7 +65,7 @@ def write(path, a):
     out.append(f"*NODE\n{m7},{NODE7[0]:.9e},{NODE7[1]:.9e},{NODE7[2]:.9e}")
     out.append(f"{ref},{X6:.9e},0.0,0.0\n{rot},{X6:.9e},0.0,0.0")
     out.append(f"*ELEMENT,TYPE=MASS,ELSET=EMASS\n{max(e for e, _, _ in elems) + 1},{m7}")
-    out += boxmesh.nset_lines("CLAMP", pface) + boxmesh.nset_lines("RIGQ", qface + [m7])
+    out += deck.nset_lines("CLAMP", pface) + deck.nset_lines("RIGQ", qface + [m7])
     out.append(f"*MASS,ELSET=EMASS\n{MASS}")
     out.append(f"*RIGID BODY,NSET=RIGQ,REF NODE={ref},ROT NODE={rot}")
     out.append("*BOUNDARY\nCLAMP,1,3")
@@ -86,13 +86,8 @@ def main():
     nn, ne = write(os.path.join(a.out, job + ".inp"), a)
     print(f"# {job}: {nn} nodes, {ne} elements", file=sys.stderr)
     if not a.reuse:
-        env = dict(os.environ, OMP_NUM_THREADS="1")
-        r = subprocess.run(["nice", "-n", "10", "ccx", "-i", job], cwd=a.out, env=env,
-                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        open(os.path.join(a.out, job + ".log"), "w").write(r.stdout)
-        if "Job finished" not in r.stdout:
-            raise SystemExit(f"ccx failed, see {a.out}/{job}.log")
-    steps = boxmesh.parse_frequencies(os.path.join(a.out, job + ".dat"))
+        deck.run_ccx(job, a.out)
+    steps = deck.parse_frequencies(os.path.join(a.out, job + ".dat"))
     if len(steps) != 1:
         raise SystemExit(f"{job}: {len(steps)} frequency steps parsed, 1 expected")
     print("case,h,mode,f_Hz")

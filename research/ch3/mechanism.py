@@ -39,9 +39,9 @@ Prints CSV: case,gravity,phi_set,M,phi_deg,z7,mode,f_Hz
 (M = the reaction moment about z on the rotation node (N m), phi_deg its
 rotation U3 in degrees, z7 = node 7's U3 (m))
 """
-import argparse, math, os, subprocess, sys, time
+import argparse, math, os, sys, time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import boxmesh
+import deck
 import component
 
 L, H, T = 0.04, 0.04, 3e-4
@@ -52,15 +52,15 @@ G = 9.81
 def write(path, a, value, gravity):
     out = ["*HEADING", f"thesis 3.5.3 mechanism, flexures {a.nl}x{a.nh}x{a.nt}, component h = {a.h}, phi = {value} deg" + (", gravity" if gravity else "")]
     hA = (T / a.nt, L / a.nl, H / a.nh)
-    nA, eA = boxmesh.boxes([((0.02 - T / 2, -0.02, -0.04), (0.02 + T / 2, 0.02, 0.0), "A")], hA)
+    nA, eA = deck.boxes([((0.02 - T / 2, -0.02, -0.04), (0.02 + T / 2, 0.02, 0.0), "A")], hA)
     hB = (L / a.nl, T / a.nt, H / a.nh)
-    nB, eB = boxmesh.boxes([((0.0, -T / 2, 0.0), (0.04, T / 2, 0.04), "B")], hB,
+    nB, eB = deck.boxes([((0.0, -T / 2, 0.0), (0.04, T / 2, 0.04), "B")], hB,
                            max(nA) + 1, eA[-1][0] + 1)
     lines, nC, eC, pface, qface = component.part_lines(a.h, max(nB) + 1, eB[-1][0] + 1)
     out.append("*NODE")
     for nodes in (nA, nB):
         out += [f"{n},{x:.12e},{y:.12e},{z:.12e}" for n, (x, y, z) in nodes.items()]
-    out += boxmesh.element_lines(eA, "C3D20R", "FLEXA") + boxmesh.element_lines(eB, "C3D20R", "FLEXB")
+    out += deck.element_lines(eA, "C3D20R", "FLEXA") + deck.element_lines(eB, "C3D20R", "FLEXB")
     out += lines
     top = max(nC)
     m7, ref5, rot5, ref6, rot6 = top + 1, top + 2, top + 3, top + 4, top + 5
@@ -70,10 +70,10 @@ def write(path, a, value, gravity):
     out += [f"*MATERIAL,NAME=STEEL\n*ELASTIC\n{E:.6e},{NU}\n*DENSITY\n{RHO}",
             "*SOLID SECTION,ELSET=FLEXA,MATERIAL=STEEL", "*SOLID SECTION,ELSET=FLEXB,MATERIAL=STEEL",
             f"*MASS,ELSET=EMASS\n{component.MASS}"]
-    clamp = boxmesh.on_plane(nA, 1, 0.02) + boxmesh.on_plane(nB, 0, 0.0)
-    rig5 = boxmesh.on_plane(nA, 1, -0.02) + boxmesh.on_plane(nB, 0, 0.04) + pface
-    out += boxmesh.nset_lines("CLAMP", clamp) + boxmesh.nset_lines("RIG5", rig5)
-    out += boxmesh.nset_lines("RIG6", qface + [m7])
+    clamp = deck.on_plane(nA, 1, 0.02) + deck.on_plane(nB, 0, 0.0)
+    rig5 = deck.on_plane(nA, 1, -0.02) + deck.on_plane(nB, 0, 0.04) + pface
+    out += deck.nset_lines("CLAMP", clamp) + deck.nset_lines("RIG5", rig5)
+    out += deck.nset_lines("RIG6", qface + [m7])
     out.append(f"*NSET,NSET=ROT5\n{rot5}\n*NSET,NSET=N7\n{m7}")
     out.append(f"*RIGID BODY,NSET=RIG5,REF NODE={ref5},ROT NODE={rot5}")
     out.append(f"*RIGID BODY,NSET=RIG6,REF NODE={ref6},ROT NODE={rot6}")
@@ -105,7 +105,7 @@ def parse(path):
             if l.strip().startswith(f"{head} for set {name}"):
                 v = [s for s in lines[i + 1:i + 4] if s.strip()][0].split()
                 got[(what, name)] = float(v[3])
-    return got.get(("u", "ROT5")), got.get(("rf", "ROT5")), got.get(("u", "N7")), boxmesh.parse_frequencies(path)
+    return got.get(("u", "ROT5")), got.get(("rf", "ROT5")), got.get(("u", "N7")), deck.parse_frequencies(path)
 
 
 def main():
@@ -129,13 +129,8 @@ def main():
         nn, ne = write(os.path.join(a.out, job + ".inp"), a, v, a.gravity)
         print(f"# {job}: {nn} nodes, {ne} elements", file=sys.stderr, flush=True)
         if not a.reuse:
-            env = dict(os.environ, OMP_NUM_THREADS="1")
             t0 = time.time()
-            r = subprocess.run(["nice", "-n", "10", "ccx", "-i", job], cwd=a.out, env=env,
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-            open(os.path.join(a.out, job + ".log"), "w").write(r.stdout)
-            if "Job finished" not in r.stdout:
-                raise SystemExit(f"ccx failed, see {a.out}/{job}.log")
+            deck.run_ccx(job, a.out)
             print(f"# {job}: ccx {time.time() - t0:.0f} s", file=sys.stderr, flush=True)
         rot, m, z7, freqs = parse(os.path.join(a.out, job + ".dat"))
         if len(freqs) != 1 or rot is None or m is None or z7 is None:

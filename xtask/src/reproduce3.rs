@@ -89,7 +89,7 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
     let (run_i, run_ii, rest) = std::thread::scope(|sc| {
         let i = sc.spawn(|| mech::run_with_bar(out, &files, Start::Reference, &adams, pg));
         let ii = sc.spawn(|| mech::run_with_bar(out, &files, Start::Equilibrium, &adams, pg));
-        let rest = the_rest(root, out, &o, &mo, &geometry, &segments, &files, pg);
+        let rest = the_rest(root, out, &mo, &geometry, &segments, &files, pg);
         let join = |h: std::thread::ScopedJoinHandle<'_, Result<mech::Run, String>>| {
             h.join()
                 .unwrap_or_else(|_| Err("a time response panicked".into()))
@@ -178,18 +178,15 @@ struct Rest {
     converged: Timed<Vec<f64>>,
 }
 
-#[allow(clippy::too_many_arguments)]
 fn the_rest(
     root: &Path,
     out: &Path,
-    o: &Ch3Options,
     mo: &MechOptions,
     geometry: &comp::Geometry,
     segments: &[ch3::Segment],
     files: &Files,
     pg: &Progress,
 ) -> Result<Rest, String> {
-    let _ = o;
     let lambdas: Vec<f64> = ch3::veering_moments()
         .iter()
         .map(|m| m / ch3::M_MAX)

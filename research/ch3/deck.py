@@ -1,5 +1,6 @@
-"""Twenty-node hexahedral meshes of unions of axis-aligned boxes, for the
-CalculiX decks of research/ch3 (issue 16).
+"""What the CalculiX decks of research/ch3 share (issue 16): twenty-node
+hexahedral meshes of unions of axis-aligned boxes, the deck's element and
+node-set lines, running ccx on one core, and reading the frequencies back.
 
 The algorithm is that of flexmb's built-in mesher (`Mesh::boxes` in
 crates/superelement/src/solid.rs), written again here so that the CalculiX
@@ -11,6 +12,8 @@ lies inside a box. Node order within an element is CalculiX's C3D20 order
 vertical mid-side nodes), the order of HEX20_LOCAL in solid.rs.
 """
 import math
+import os
+import subprocess
 
 # (a, b, c) in {0, 1, 2}^3 per element node, as HEX20_LOCAL in solid.rs
 HEX20_LOCAL = [
@@ -105,3 +108,14 @@ def parse_frequencies(path):
             continue
         i += 1
     return out
+
+
+def run_ccx(job, out):
+    """Runs `ccx -i job` in the folder `out` on one core at low priority,
+    keeps its output in job.log and stops the script if ccx failed."""
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    r = subprocess.run(["nice", "-n", "10", "ccx", "-i", job], cwd=out, env=env,
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    open(os.path.join(out, job + ".log"), "w").write(r.stdout)
+    if "Job finished" not in r.stdout:
+        raise SystemExit(f"ccx failed, see {out}/{job}.log")
