@@ -7,6 +7,7 @@
 
 pub mod ch2;
 pub mod ch3;
+pub mod ch4;
 pub mod ch5;
 pub mod ch6;
 pub mod curves;
@@ -17,6 +18,7 @@ pub mod progress;
 pub mod regress;
 pub mod report;
 pub mod reproduce3;
+pub mod reproduce4;
 pub mod reproduce6;
 pub mod solid6;
 

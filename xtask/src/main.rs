@@ -1,4 +1,4 @@
-//! `cargo xtask reproduce ch2|ch3|ch5|ch6|all`, `cargo xtask regress` and `cargo xtask fuzz`.
+//! `cargo xtask reproduce ch2|ch3|ch4|ch5|ch6|all`, `cargo xtask regress` and `cargo xtask fuzz`.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -20,6 +20,7 @@ struct Cli {
 enum Chapter {
     Ch2,
     Ch3,
+    Ch4,
     Ch5,
     Ch6,
     All,
@@ -39,18 +40,26 @@ enum FuzzTarget {
 enum Cmd {
     /// Regenerate a chapter's results into OUT/chN (CSV, SVG, report.md).
     Reproduce {
-        /// ch2, ch3, ch5, ch6 or all.
+        /// ch2, ch3, ch4, ch5, ch6 or all.
         chapter: Chapter,
         /// Output directory.
         #[arg(long, default_value = "results")]
         out: PathBuf,
+    },
+    /// Build the chapter-4 mechanism's part superelements from their FE
+    /// models and write them with its scene and skeletons to
+    /// fixtures/scenes (two_dof_mechanism.ron, two_dof_mechanism/*.se.ron).
+    Mechanism4 {
+        /// Write into this directory instead of fixtures/scenes.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Recompute the eigenfrequency curves and compare them with fixtures/curves.
     Regress {
         /// Store the recomputed curves as the new fixtures instead of comparing.
         #[arg(long)]
         update: bool,
-        /// Only this chapter's curves (ch2, ch3, ch5 or ch6; default all).
+        /// Only this chapter's curves (ch2, ch3, ch4, ch5 or ch6; default all).
         #[arg(long, value_enum)]
         chapter: Option<Chapter>,
     },
@@ -106,6 +115,7 @@ fn main() -> ExitCode {
             };
             reproduce(&root, &out, chapter, &pg)
         }
+        Cmd::Mechanism4 { out } => mechanism4(out.unwrap_or_else(xtask::ch4::fixture_dir)),
         Cmd::Regress { update, chapter } => {
             regress(&root, update, chapter.unwrap_or(Chapter::All), &pg)
         }
@@ -149,6 +159,24 @@ fn main() -> ExitCode {
     }
 }
 
+fn mechanism4(dir: PathBuf) -> Result<(), String> {
+    let t = std::time::Instant::now();
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let builds = xtask::ch4::write_model(&dir, &|name| eprintln!("  built {name}"))?;
+    for b in &builds {
+        println!(
+            "{:<48} {:>6} elements {:>8.4} kg {:>6.1} s  {}",
+            b.what, b.elements, b.mass, b.seconds, b.file
+        );
+    }
+    println!(
+        "wrote {} and its skeletons in {:.0} s",
+        dir.join(xtask::ch4::SCENE_FILE).display(),
+        t.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
 fn reproduce(
     root: &std::path::Path,
     out: &std::path::Path,
@@ -173,6 +201,15 @@ fn reproduce(
             "chapter 3 in {:.0} s: {}",
             t.elapsed().as_secs_f64(),
             out.join("ch3/report.md").display()
+        ));
+    }
+    if matches!(ch, Chapter::Ch4 | Chapter::All) {
+        let t = std::time::Instant::now();
+        xtask::reproduce4::reproduce(root, &out.join("ch4"), pg)?;
+        summary.push(format!(
+            "chapter 4 in {:.0} s: {}",
+            t.elapsed().as_secs_f64(),
+            out.join("ch4/report.md").display()
         ));
     }
     if matches!(ch, Chapter::Ch5 | Chapter::All) {
@@ -209,9 +246,10 @@ fn regress(
     pg: &Progress,
 ) -> Result<(), String> {
     type Recompute = fn(&std::path::Path, &Progress) -> Result<xtask::regress::Recomputed, String>;
-    let chapters: [(Chapter, Recompute); 4] = [
+    let chapters: [(Chapter, Recompute); 5] = [
         (Chapter::Ch2, xtask::regress::recompute_ch2),
         (Chapter::Ch3, xtask::ch3::recompute),
+        (Chapter::Ch4, xtask::reproduce4::recompute),
         (Chapter::Ch5, xtask::regress::recompute_ch5),
         (Chapter::Ch6, xtask::regress::recompute_ch6),
     ];

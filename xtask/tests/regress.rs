@@ -34,6 +34,15 @@ fn chapter_3_curves_match_the_stored_ones() {
 }
 
 #[test]
+fn chapter_4_curves_match_the_stored_ones() {
+    let root = xtask::workspace_root();
+    assert_matches_fixtures(
+        &xtask::reproduce4::recompute(&root, &Progress::hidden()).unwrap(),
+        1,
+    );
+}
+
+#[test]
 fn chapter_5_curves_match_the_stored_ones() {
     let root = xtask::workspace_root();
     assert_matches_fixtures(&recompute_ch5(&root, &Progress::hidden()).unwrap(), 5);

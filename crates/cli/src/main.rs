@@ -827,6 +827,9 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
         match outcome.chart_switches.len() {
             0 => String::new(),
             c => format!(", {c} chart switches of free orientations on the way"),
+        } + &match outcome.partition_switches.len() {
+            0 => String::new(),
+            c => format!(", {c} changes of the dependent nodal coordinates on the way"),
         }
     );
     let sw = FrequencySweep {

@@ -137,3 +137,101 @@ pub(crate) fn integration_error(mech: &Mechanism, layout: StateLayout, e: &OdeEr
         None => e.to_string(),
     }
 }
+
+/// A pivot ratio of J at most this fraction of the one at the start of a
+/// run marks a configuration near a singular one in a stall's explanation.
+const NEAR_SINGULAR: f64 = 1e-2;
+
+/// At most this many DOFs are named as the fastest accelerating.
+const MAX_FASTEST: usize = 3;
+
+impl crate::Dynamics {
+    /// Why a run may have stalled at (t, q, q̇), its last accepted step,
+    /// when no evaluation failed (an implicit step whose Newton iterations
+    /// stop converging, a step size that error estimates alone shrink),
+    /// for the message of the integrator's error: either the kinematics is
+    /// near a singular configuration there (the pivot ratio of J has fallen
+    /// to at most [`NEAR_SINGULAR`] of `start_pivot`, its value at the start
+    /// of the run), naming the dependent coordinates J determines worst, or
+    /// the degrees of freedom with the largest accelerations. Error path
+    /// only: it solves and evaluates afresh.
+    pub(crate) fn explain_stall(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        start_pivot: f64,
+    ) -> String {
+        let at = format!("at the last accepted step (t = {t:.6})");
+        if let Err(e) = self.kinematics_at(t, q, None) {
+            return format!("{at} the position solve fails: {e}");
+        }
+        let pivot = self.kin.pivot_ratio();
+        if pivot <= NEAR_SINGULAR * start_pivot {
+            let names = self.kin.least_determined_coordinates();
+            return format!(
+                "no evaluation failed; {at} the mechanism is near a singular configuration: the \
+                 pivot ratio of the kinematic Jacobian fell to {:.2e} from {:.2e} at the start, and it \
+                 determines the dependent coordinates{} least (a straightened toggle, a \
+                 prescribed motion at the edge of its reach, or, with nodal coordinates as \
+                 DOFs, a dependent set that no other set betters there)",
+                pivot,
+                start_pivot,
+                listed(" ", &names)
+            );
+        }
+        let mut qdd = vec![0.0; q.len()];
+        if let Err(e) = self.accelerations(t, q, qd, &mut qdd) {
+            return format!("{at} the equations of motion fail: {e}");
+        }
+        let mut order: Vec<usize> = (0..q.len()).collect();
+        order.sort_by(|a, b| qdd[*b].abs().total_cmp(&qdd[*a].abs()));
+        let fastest: Vec<String> = order
+            .iter()
+            .take(MAX_FASTEST)
+            .map(|k| format!("{} (q̈ = {:.3e})", self.mech.dof_label(*k), qdd[*k]))
+            .collect();
+        format!(
+            "no evaluation failed; {at} the kinematics is regular (pivot ratio {:.2e}, {:.2e} at \
+             the start) and the largest accelerations are{}: the motion may be too fast or too \
+             stiff for the tolerances there, or an input may jump",
+            pivot,
+            start_pivot,
+            listed(" ", &fastest)
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::Dynamics;
+    use std::sync::Arc;
+
+    /// At a regular configuration a stall is explained by the largest
+    /// accelerations: a free point mass of 2 kg under (0, −6) N accelerates
+    /// by −3 m/s² in y, 0 in x.
+    #[test]
+    fn a_stall_at_a_regular_configuration_names_the_fastest_dofs() {
+        let mech = flexmb_model::Scene::from_ron_str(
+            r#"(
+        dimension: Planar,
+        nodes: [ (id: "S", at: [0.0, 0.0]) ],
+        elements: [ (id: "m", type: PointMass(node: "S", mass: 2.0)) ],
+        loads: [ (node: "S", force: Some([0.0, -6.0])) ],
+    )"#,
+        )
+        .unwrap()
+        .build(None)
+        .unwrap();
+        let mut dy = Dynamics::new(Arc::new(mech));
+        let why = dy.explain_stall(0.5, &[0.0, 0.0], &[1.0, 0.0], 1.0);
+        for part in [
+            "no evaluation failed",
+            "t = 0.500000",
+            "regular",
+            "largest accelerations are DOF q1 = S.y (node S) (q̈ = -3.000e0)",
+        ] {
+            assert!(why.contains(part), "`{part}` missing from: {why}");
+        }
+    }
+}

@@ -39,19 +39,36 @@ pub const PARTITION_IMPROVEMENT: f64 = 4.0;
 pub const PARTITION_RECOVERY: f64 = 0.5;
 
 /// The state of a run's watch on the dependent set.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(crate) struct PartitionWatch {
     /// The pivot ratio of J just after the set was chosen (or last found
     /// to be the best one).
     pub(crate) reference: f64,
-    /// The estimated smallest singular value of J when the set was chosen.
-    pub(crate) quality: f64,
+    /// The configuration where the set was chosen.
+    x_chosen: Vec<f64>,
+    /// The estimated smallest singular value of J there, computed when a
+    /// run first needs it ([`quality`](Self::quality)): the pivoted QR over
+    /// every dependent coordinate is cubic in their number (5 s for the
+    /// 1520 of the chapter-4 mechanism with its end-effector's x and y as
+    /// DOFs), and most runs never degrade.
+    quality: Option<f64>,
 }
 
 impl PartitionWatch {
     /// Whether the pivot ratio `now` calls for a new choice.
     pub(crate) fn degraded(&self, now: f64) -> bool {
         now < PARTITION_SWITCH_RATIO * self.reference
+    }
+
+    /// The estimated smallest singular value of J at the configuration
+    /// where the set was chosen (`dy` on the same mechanism as then).
+    pub(crate) fn quality(&mut self, dy: &Dynamics) -> f64 {
+        if let Some(q) = self.quality {
+            return q;
+        }
+        let q = dy.set_quality_at(&self.x_chosen).unwrap_or(0.0);
+        self.quality = Some(q);
+        q
     }
 }
 
@@ -64,8 +81,39 @@ impl Dynamics {
         }
         Some(PartitionWatch {
             reference: self.kin.pivot_ratio(),
-            quality: self.current_set_quality().unwrap_or(0.0),
+            x_chosen: self.kin.x().to_vec(),
+            quality: None,
         })
+    }
+
+    /// [`current_set_quality`](Self::current_set_quality) at the nodal
+    /// coordinates `x` (element Jacobians evaluated there, not those of the
+    /// kinematics' current configuration).
+    fn set_quality_at(&self, x: &[f64]) -> Option<f64> {
+        let jacobians: Vec<Vec<f64>> = self
+            .mech
+            .elements
+            .iter()
+            .map(|e| {
+                let (ne, nx) = (e.element.n_eps(), e.element.n_x());
+                let mut xl = vec![0.0; nx];
+                e.gather(x, &mut xl);
+                let (mut eps, mut jac) = (vec![0.0; ne], vec![0.0; ne * nx]);
+                e.element
+                    .deformations_and_jacobian(&xl, None, &mut eps, &mut jac);
+                jac
+            })
+            .collect();
+        let eligible = self.mech.partition_eligible();
+        let (forced, rest): (Vec<usize>, Vec<usize>) = self
+            .mech
+            .dependent
+            .iter()
+            .partition(|i| !eligible.contains(i));
+        let cols: Vec<usize> = forced.iter().chain(&rest).copied().collect();
+        let a = constraint_jacobian(&self.mech, |k| &jacobians[k], &cols);
+        let n_c = self.mech.constraint_rows.len();
+        pivoted_qr_picks(a, n_c, cols.len(), forced.len()).map(|(_, r)| r)
     }
 
     /// The best-conditioned dependent set at the current (solved)
@@ -75,7 +123,20 @@ impl Dynamics {
     /// square regular block over the candidates (a picked column is at the
     /// rounding level of the largest).
     pub fn best_dependent_set(&self) -> Option<(Vec<usize>, f64)> {
-        let eligible = self.mech.partition_eligible();
+        self.best_dependent_set_keeping(&[])
+    }
+
+    /// [`best_dependent_set`](Self::best_dependent_set) with the
+    /// coordinates of the DOF slots `keep` kept as DOFs (the held DOFs of a
+    /// static solve: a held value must keep its meaning).
+    fn best_dependent_set_keeping(&self, keep: &[usize]) -> Option<(Vec<usize>, f64)> {
+        let kept = self.kept_coordinates(keep);
+        let eligible: Vec<usize> = self
+            .mech
+            .partition_eligible()
+            .into_iter()
+            .filter(|i| !kept.contains(i))
+            .collect();
         let forced: Vec<usize> = self
             .mech
             .dependent
@@ -84,6 +145,16 @@ impl Dynamics {
             .filter(|i| !eligible.contains(i))
             .collect();
         self.pivoted_picks(&forced, &eligible)
+    }
+
+    /// The nodal coordinates in the DOF slots `keep`.
+    fn kept_coordinates(&self, keep: &[usize]) -> Vec<usize> {
+        keep.iter()
+            .filter_map(|s| match self.mech.dofs.get(*s) {
+                Some(flexmb_model::Coordinate::Node(i)) => Some(*i),
+                _ => None,
+            })
+            .collect()
     }
 
     /// The same estimate for the current dependent set.
@@ -107,12 +178,13 @@ impl Dynamics {
         Some((picks.into_iter().map(|c| cols[c]).collect(), r_min))
     }
 
-    /// [`best_dependent_set`](Self::best_dependent_set) if it is another
+    /// [`best_dependent_set`](Self::best_dependent_set), with the
+    /// coordinates of the DOF slots `keep` kept as DOFs, if it is another
     /// set than the current one, [`PARTITION_IMPROVEMENT`] times better
     /// conditioned, and at least [`PARTITION_RECOVERY`] times as well as
     /// `chosen` (the current set's estimate when it was chosen).
-    pub(crate) fn better_dependent_set(&self, chosen: f64) -> Option<Vec<usize>> {
-        let (mut best, r_best) = self.best_dependent_set()?;
+    pub(crate) fn better_dependent_set(&self, chosen: f64, keep: &[usize]) -> Option<Vec<usize>> {
+        let (mut best, r_best) = self.best_dependent_set_keeping(keep)?;
         best.sort_unstable();
         let mut now = self.mech.dependent.clone();
         now.sort_unstable();
@@ -126,20 +198,23 @@ impl Dynamics {
     /// ([`best_dependent_set`](Self::best_dependent_set), better as for the
     /// run's watch: [`PARTITION_IMPROVEMENT`] times the current set's
     /// estimate and `PARTITION_RECOVERY` of `chosen`, the estimate the
-    /// current set had when it was chosen; 0 to require only the first):
-    /// rebuilds the dynamics with it, its position solve starting from the
-    /// current configuration, and returns q, q̇ in it (mapped through x,
-    /// ẋ). `None` if the set stays. The switch is appended to `log`.
+    /// current set had when it was chosen; 0 to require only the first),
+    /// the coordinates of the DOF slots `keep` staying DOFs (the held DOFs
+    /// of a static solve): rebuilds the dynamics with it, its position
+    /// solve starting from the current configuration, and returns q, q̇ in
+    /// it (mapped through x, ẋ). `None` if the set stays. The switch is
+    /// appended to `log`.
     pub fn switch_partition(
         &mut self,
         t: f64,
         q: &[f64],
         qd: &[f64],
         chosen: f64,
+        keep: &[usize],
         log: &mut Vec<PartitionSwitch>,
     ) -> Result<Option<StateInSet>, DynamicsError> {
         self.kinematics_at(t, q, Some(qd))?;
-        let Some(best) = self.better_dependent_set(chosen) else {
+        let Some(best) = self.better_dependent_set(chosen, keep) else {
             return Ok(None);
         };
         let mut mech = (*self.mech).clone();

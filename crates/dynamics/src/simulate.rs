@@ -396,6 +396,11 @@ struct StepWatch {
     /// The last evaluation that failed recoverably (the integrator retried
     /// with a smaller step): the reason to give if the run fails after it.
     last_failure: Option<(f64, String)>,
+    /// The pivot ratio of J at the start of the segment, and (t, q, q̇) of
+    /// the last accepted step (buffers reused from step to step): where a
+    /// run ends without an evaluation that failed, the state to explain.
+    start_pivot: f64,
+    last_accepted: (f64, Vec<f64>, Vec<f64>),
 }
 
 impl StepWatch {
@@ -406,6 +411,8 @@ impl StepWatch {
             x: Rc::new(RefCell::new(dy.kin.x().to_vec())),
             switch_at: None,
             last_failure: None,
+            start_pivot: dy.kin.pivot_ratio(),
+            last_accepted: (f64::NAN, vec![], vec![]),
         }
     }
 
@@ -419,12 +426,35 @@ impl StepWatch {
     }
 
     /// An integration error with the last recoverable evaluation failure
-    /// when there was one: a step-size underflow names its cause.
-    fn with_cause(&self, e: DynamicsError) -> DynamicsError {
-        with_failure_cause(e, self.last_failure.as_ref())
+    /// when there was one: a step-size underflow names its cause. Without
+    /// one (an implicit integrator whose Newton iterations stop converging,
+    /// or a step size that shrinks on error estimates alone), the state of
+    /// the last accepted step is explained instead
+    /// ([`Dynamics::explain_stall`]).
+    fn with_cause(&self, dy: &mut Dynamics, e: DynamicsError) -> DynamicsError {
+        if self.last_failure.is_some() {
+            return with_failure_cause(e, self.last_failure.as_ref());
+        }
+        let (t, q, qd) = &self.last_accepted;
+        match e {
+            DynamicsError::Integration { source, message } if !q.is_empty() => {
+                let why = dy.explain_stall(*t, q, qd, self.start_pivot);
+                DynamicsError::Integration {
+                    source,
+                    message: format!("{message}; {why}"),
+                }
+            }
+            e => e,
+        }
     }
 
     fn accepted(&mut self, dy: &mut Dynamics, t: f64, q: &[f64], qd: &[f64]) -> Control {
+        let (ta, qa, qda) = &mut self.last_accepted;
+        *ta = t;
+        qa.clear();
+        qa.extend_from_slice(q);
+        qda.clear();
+        qda.extend_from_slice(qd);
         self.x.borrow_mut().copy_from_slice(dy.kin.x());
         if self.charts.iter().any(|c| c.needs_switch(q).is_some()) || self.partition_degraded(dy) {
             self.switch_at = Some((t, q.to_vec(), qd.to_vec()));
@@ -445,7 +475,8 @@ impl StepWatch {
         if !w.degraded(now) {
             return false;
         }
-        if dy.better_dependent_set(w.quality).is_some() {
+        let chosen = w.quality(dy);
+        if dy.better_dependent_set(chosen, &[]).is_some() {
             return true;
         }
         w.reference = now;
@@ -753,9 +784,12 @@ impl Dynamics {
             (q, qd) = (qs, qds);
             // the dependent set first, in the chart whose J the watch
             // measured; a new set or chart has a reference of its own
-            if let Some(w) = partition.filter(|w| w.degraded(self.kin.pivot_ratio())) {
+            let degraded = partition
+                .as_mut()
+                .filter(|w| w.degraded(self.kin.pivot_ratio()));
+            if let Some(chosen) = degraded.map(|w| w.quality(self)) {
                 let log = &mut traj.partition_switches;
-                if let Some((q1, qd1)) = self.switch_partition(t, &q, &qd, w.quality, log)? {
+                if let Some((q1, qd1)) = self.switch_partition(t, &q, &qd, chosen, &[], log)? {
                     (q, qd) = (q1, qd1);
                     partition = self.partition_watch();
                 } else if let Some(w) = &mut partition {
@@ -848,10 +882,12 @@ impl Dynamics {
                     |e| integration_error(&mech, StateLayout::FirstOrder, e),
                 );
                 let watch = sys.watch.expect("set above");
-                *partition = watch.partition;
+                *partition = watch.partition.clone();
                 let (stats, stopped) = match run {
                     Ok(r) => r,
-                    Err(e @ DynamicsError::Integration { .. }) => return Err(watch.with_cause(e)),
+                    Err(e @ DynamicsError::Integration { .. }) => {
+                        return Err(watch.with_cause(sys.dy, e))
+                    }
                     Err(e) => return Err(e),
                 };
                 let switch_at = watch.switch_at;
@@ -887,7 +923,7 @@ impl Dynamics {
                     },
                 );
                 sys.dy.kin.set_stop(None);
-                *partition = sys.watch.partition;
+                *partition = sys.watch.partition.clone();
                 let sol = match solved {
                     Ok(sol) => sol,
                     // the start-up mass matrix is singular: the projection's
@@ -900,9 +936,9 @@ impl Dynamics {
                             Err(named @ DynamicsError::SingularMass { .. }) => named,
                             _ => to_err(e),
                         };
-                        return Err(sys.watch.with_cause(named));
+                        return Err(sys.watch.with_cause(sys.dy, named));
                     }
-                    Err(e) => return Err(sys.watch.with_cause(to_err(e))),
+                    Err(e) => return Err(sys.watch.with_cause(sys.dy, to_err(e))),
                 };
                 if let Some((t, q, qd)) = sys.stopped_at.take() {
                     if t > last_output {

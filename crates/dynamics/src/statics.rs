@@ -126,10 +126,18 @@ pub struct StaticSolution {
     pub reactions: Vec<f64>,
     /// The Euler-parameter charts switched on the way (free orientations
     /// turned by more than about 127° since their chart was chosen, see
-    /// `flexmb_model::EulerChart`). When there were any, `q` is in the
+    /// `flexmb_model::EulerChart`), each with the load factor at which it
+    /// happened in its `t`. When there were any, `q` is in the
     /// chart of [`Dynamics::mechanism`] after the call, not in the one
     /// before it; `x` is the same in every chart.
     pub chart_switches: Vec<flexmb_model::ChartSwitch>,
+    /// The changes of the dependent nodal coordinates on the way (nodal
+    /// DOFs whose dependent set got ill-conditioned, e.g. the x of the nodes
+    /// of a beam with rigid elongations turned near 90°; docs/ARCHITECTURE.md,
+    /// "Re-partitioning of nodal DOFs"), each with its load factor in `t`:
+    /// the held DOFs keep their coordinates. As with `chart_switches`, `q` is then in the set of
+    /// [`Dynamics::mechanism`] after the call.
+    pub partition_switches: Vec<flexmb_model::PartitionSwitch>,
 }
 
 impl Dynamics {
@@ -532,9 +540,22 @@ impl Dynamics {
         // rejected iterate or increment)
         let mut dq_last = vec![0.0; free.len()];
         let mut dh = vec![0.0; opts.held.len()];
+        // the watch on the dependent nodal coordinates (nodal DOFs), read
+        // after each converged increment as a simulation reads it after
+        // each step
+        let mut partition = if self.mech.partition_eligible().is_empty() {
+            None
+        } else {
+            self.kin
+                .solve(&q, t)
+                .ok()
+                .and_then(|_| self.partition_watch())
+        };
         let mut x_ok = self.kin.x().to_vec();
         let mut x_good = x_ok.clone();
         let mut chart_switches = vec![];
+        let mut partition_switches = vec![];
+        let held_slots: Vec<usize> = opts.held.iter().map(|(i, _)| *i).collect();
         while lambda < 1.0 - 1e-15 {
             let target = (lambda + dl).min(1.0);
             self.load_factor = if opts.ramp_loads { target } else { 1.0 };
@@ -721,22 +742,50 @@ impl Dynamics {
             if converged {
                 lambda = target;
                 increments += 1;
-                // a free orientation that turned far gets a regular chart
+                // with nodal DOFs, a dependent set that has got
+                // ill-conditioned is chosen again (a beam with rigid
+                // elongations near 90°), the held DOFs staying DOFs; then a
+                // free orientation that turned far gets a regular chart
                 // before the next increment (the one it has is singular
-                // 180° from where it was chosen): q in the new chart, the
-                // same configuration
+                // 180° from where it was chosen): q in the new set and
+                // chart, the same configuration
+                let rest = vec![0.0; n_q];
+                let degraded = partition
+                    .as_mut()
+                    .filter(|w| w.degraded(self.kin.pivot_ratio()));
+                if let Some(chosen) = degraded.map(|w| w.quality(self)) {
+                    let q_here = q.clone();
+                    let log = &mut partition_switches;
+                    match self.switch_partition(t, &q_here, &rest, chosen, &held_slots, log)? {
+                        Some((q1, _)) => {
+                            // a static solve logs the load factor
+                            if let Some(sw) = partition_switches.last_mut() {
+                                sw.t = lambda;
+                            }
+                            q = q1;
+                            x_ok.copy_from_slice(self.kin.x());
+                            force_refresh = true;
+                            partition = self.partition_watch();
+                        }
+                        None => {
+                            if let Some(w) = &mut partition {
+                                w.reference = self.kin.pivot_ratio();
+                            }
+                        }
+                    }
+                }
                 let q_here = q.clone();
-                let held_slots: Vec<usize> = opts.held.iter().map(|(i, _)| *i).collect();
-                if let Some((q1, _)) = self.switch_charts(
-                    t,
-                    &q_here,
-                    &vec![0.0; n_q],
-                    &held_slots,
-                    &mut chart_switches,
-                )? {
+                let logged = chart_switches.len();
+                if let Some((q1, _)) =
+                    self.switch_charts(t, &q_here, &rest, &held_slots, &mut chart_switches)?
+                {
+                    for sw in &mut chart_switches[logged..] {
+                        sw.t = lambda;
+                    }
                     q = q1;
                     x_ok.copy_from_slice(self.kin.x());
                     force_refresh = true;
+                    partition = self.partition_watch();
                 }
                 last_good.copy_from_slice(&q);
                 x_good.copy_from_slice(&x_ok);
@@ -798,6 +847,7 @@ impl Dynamics {
             increments,
             reactions,
             chart_switches,
+            partition_switches,
         })
     }
 }

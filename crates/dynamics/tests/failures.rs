@@ -91,10 +91,7 @@ fn a_mechanism_driven_out_of_reach_names_the_failing_equations() {
 /// set degrades alike (at it no square block of D_c,x is regular: both
 /// elongations depend on B.x alone), so none that restores the
 /// conditioning exists and the run ends as with deformation DOFs, naming
-/// what failed. (Generalized-α is left out: with nodal DOFs its Newton
-/// iterations stop converging near the stretched position without an
-/// evaluation that fails, and no dependent set was changed in that run,
-/// so its step-size underflow has no evaluation to name.)
+/// what failed.
 #[test]
 fn with_nodal_dofs_a_mechanism_driven_out_of_reach_still_names_the_failing_equations() {
     let mut scene = out_of_reach_scene();
@@ -102,6 +99,40 @@ fn with_nodal_dofs_a_mechanism_driven_out_of_reach_still_names_the_failing_equat
     let mech = Arc::new(scene.build(None).unwrap());
     assert!(!mech.partition_eligible().is_empty());
     out_of_reach_names_the_failing_equations(mech, &[Integrator::Dopri5, Integrator::Adams]);
+}
+
+/// Generalized-α on the same: its Newton iterations stop converging near the
+/// stretched position without an evaluation that fails (issue 15 item 4:
+/// before, the run ended with "step size underflow" alone). The message
+/// explains the state of the last accepted step instead: the kinematic
+/// Jacobian near singular there (its pivot ratio measured 7.3e-7 against 1
+/// at the start) and the dependent coordinates it determines least.
+#[test]
+fn a_stall_without_a_failed_evaluation_is_explained_by_the_last_accepted_state() {
+    let mut scene = out_of_reach_scene();
+    scene.dofs = flexmb_model::DofChoice::NodalCoordinates;
+    let mech = Arc::new(scene.build(None).unwrap());
+    let mut dy = Dynamics::new(mech.clone());
+    let q0 = mech.q0();
+    let opts = SimulationOptions::new(Integrator::GeneralizedAlpha, 0.0, 1.0, 11);
+    let err = dy
+        .simulate(0.0, &q0, &vec![0.0; q0.len()], &opts, |_, _, _| {
+            Control::Continue
+        })
+        .expect_err("the end is driven out of reach");
+    let msg = err.to_string();
+    assert!(
+        matches!(&err, DynamicsError::Integration { .. }),
+        "not an integration error: {err:?}"
+    );
+    for part in [
+        "no evaluation failed",
+        "at the last accepted step",
+        "near a singular configuration",
+        "C.y",
+    ] {
+        assert!(msg.contains(part), "`{part}` missing from: {msg}");
+    }
 }
 
 fn out_of_reach_names_the_failing_equations(

@@ -128,6 +128,27 @@ pub(crate) enum CustomInertia {
 pub(crate) struct CustomKind {
     pub kernel: Arc<dyn ErasedKernel>,
     pub inertia: Option<CustomInertia>,
+    /// The periodic deformations (index, period), e.g. an angle from atan2
+    /// (period 2π): continued from the previous deformations
+    /// ([`Element::with_periodic_deformation`](crate::Element::with_periodic_deformation)).
+    pub periodic: Vec<(usize, f64)>,
+}
+
+impl CustomKind {
+    /// Moves each periodic deformation of `eps` by the multiple of its
+    /// period that puts it closest to its previous value `prev` (the
+    /// derivatives are unchanged): a hinge angle stays continuous over many
+    /// turns, as the built-in spatial hinge's does.
+    pub(crate) fn continue_from(&self, prev: Option<&[f64]>, eps: &mut [f64]) {
+        let Some(prev) = prev else {
+            return;
+        };
+        for &(i, period) in &self.periodic {
+            if let (Some(e), Some(p)) = (eps.get(i).copied(), prev.get(i)) {
+                eps[i] = e + ((p - e) / period).round() * period;
+            }
+        }
+    }
 }
 
 impl std::fmt::Debug for CustomKind {
@@ -152,6 +173,7 @@ impl PartialEq for CustomKind {
     /// constant mass.
     fn eq(&self, o: &Self) -> bool {
         Arc::ptr_eq(&self.kernel, &o.kernel)
+            && self.periodic == o.periodic
             && match (&self.inertia, &o.inertia) {
                 (None, None) => true,
                 (Some(CustomInertia::Constant(a)), Some(CustomInertia::Constant(b))) => a == b,

@@ -672,12 +672,61 @@ impl Element {
                     _sizes: std::marker::PhantomData,
                 }),
                 inertia: None,
+                periodic: vec![],
             }),
             slots.to_vec(),
             names(deformation_names),
             DMatrix::zeros(NE, NE),
         );
         e.with_stiffness(stiffness)
+    }
+
+    /// Declares deformation `index` of a custom element ([`custom`](Self::custom))
+    /// periodic with `period`: an angle that the kernel computes from an
+    /// `atan2`, say, is in (−π, π] and jumps by 2π where it passes π.
+    /// [`deformations`](Self::deformations) and
+    /// [`deformations_and_jacobian`](Self::deformations_and_jacobian) then
+    /// continue it from the previous deformations they are given (`prev`, as
+    /// the kinematics passes the last converged solution), adding the
+    /// multiple of `period` that puts it closest there, so that a hinge
+    /// written as a custom element turns through any number of revolutions
+    /// as the built-in ones do. Its derivatives are those of the kernel.
+    /// Errors: not a custom element, an index beyond its deformations, a
+    /// period that is not positive and finite.
+    pub fn with_periodic_deformation(
+        mut self,
+        index: usize,
+        period: f64,
+    ) -> Result<Self, ElementError> {
+        let n = self.n_eps();
+        let name = self.type_name().to_string();
+        let Kind::Custom(c) = &mut self.kind else {
+            return Err(ElementError::InvalidProperty {
+                what: "periodic deformation".into(),
+                value: index as f64,
+                why: format!("only a custom element takes one, not a {name}"),
+            });
+        };
+        if index >= n {
+            return Err(ElementError::InvalidProperty {
+                what: format!("custom element '{name}' periodic deformation index"),
+                value: index as f64,
+                why: format!(
+                    "the element has {n} deformations (0 … {})",
+                    n.saturating_sub(1)
+                ),
+            });
+        }
+        if !(period.is_finite() && period > 0.0) {
+            return Err(ElementError::InvalidProperty {
+                what: format!("custom element '{name}' period of deformation {index}"),
+                value: period,
+                why: "must be positive and finite (2π for an angle)".into(),
+            });
+        }
+        c.periodic.retain(|(i, _)| *i != index);
+        c.periodic.push((index, period));
+        Ok(self)
     }
 
     /// Gives a custom element ([`custom`](Self::custom)) a constant mass
@@ -1063,7 +1112,8 @@ impl Element {
             }};
         }
         if let Kind::Custom(c) = &self.kind {
-            return c.kernel.deformations(x, eps);
+            c.kernel.deformations(x, eps);
+            return c.continue_from(prev, eps);
         }
         self.dispatch_def(x, prev, |k| each_kernel!(k, go));
         self.copy_modes(x, eps);
@@ -1120,7 +1170,8 @@ impl Element {
             }};
         }
         if let Kind::Custom(c) = &self.kind {
-            return c.kernel.jacobian(x, eps, jac);
+            c.kernel.jacobian(x, eps, jac);
+            return c.continue_from(prev, eps);
         }
         self.dispatch_def(x, prev, |k| each_kernel!(k, go));
         let k = self.mode_count();

@@ -542,3 +542,120 @@ fn the_largest_custom_element_evaluates_on_a_default_thread_stack() {
         .join()
         .unwrap();
 }
+
+/// The direction of a planar bar against its initial one, from an atan2:
+/// ε = atan2(Δy, Δx) − β0, in (−π − β0, π − β0].
+struct Direction {
+    beta0: f64,
+}
+
+impl DeformationKernel<4, 1> for Direction {
+    fn eval<T: Real>(&self, x: &[T; 4]) -> [T; 1] {
+        let (dx, dy) = (x[2] - x[0], x[3] - x[1]);
+        [dy.atan2(dx) - self.beta0]
+    }
+}
+
+fn direction(periodic: bool) -> Element {
+    let e = Element::custom(
+        "direction",
+        Direction { beta0: 0.0 },
+        &[Slot::Position2, Slot::Position2],
+        &["angle"],
+        DMatrix::from_element(1, 1, 1.0),
+    )
+    .unwrap();
+    if periodic {
+        e.with_periodic_deformation(0, 2.0 * std::f64::consts::PI)
+            .unwrap()
+    } else {
+        e
+    }
+}
+
+/// A periodic deformation of a custom element is continued from the
+/// previous deformations (issue 19: custom elements ignored `prev`): a bar
+/// turned through three revolutions in steps of 0.3 rad has ε equal to the
+/// angle turned, in `deformations` and in `deformations_and_jacobian`; the
+/// same kernel without the declaration jumps back by 2π at every half turn.
+#[test]
+fn a_periodic_custom_deformation_turns_through_many_revolutions() {
+    let (periodic, plain) = (direction(true), direction(false));
+    let mut prev = [0.0];
+    let mut jumps = 0;
+    for k in 1..=63 {
+        let a = 0.3 * k as f64;
+        let x = [0.2, -0.1, 0.2 + 1.5 * a.cos(), -0.1 + 1.5 * a.sin()];
+        let mut e = [0.0];
+        periodic.deformations(&x, Some(&prev), &mut e);
+        assert!((e[0] - a).abs() < 1e-12, "turned {a}: ε = {}", e[0]);
+        let (mut ej, mut j) = ([0.0], [0.0; 4]);
+        periodic.deformations_and_jacobian(&x, Some(&prev), &mut ej, &mut j);
+        assert_eq!(ej, e);
+        // the derivative of the angle: (−Δy, Δx)/l² at q
+        let (dx, dy) = (x[2] - x[0], x[3] - x[1]);
+        let l2 = dx * dx + dy * dy;
+        assert!((j[2] + dy / l2).abs() < 1e-12 && (j[3] - dx / l2).abs() < 1e-12);
+        let mut e_plain = [0.0];
+        plain.deformations(&x, Some(&prev), &mut e_plain);
+        if (e_plain[0] - a).abs() > 1.0 {
+            jumps += 1;
+        }
+        prev = e;
+    }
+    assert!(jumps > 30, "the plain kernel stayed continuous: {jumps}");
+    // a bad declaration is an error naming it
+    let err = |r: Result<Element, ElementError>| r.unwrap_err().to_string();
+    assert!(err(direction(false).with_periodic_deformation(1, 1.0)).contains("1 deformations"));
+    assert!(err(direction(false).with_periodic_deformation(0, 0.0)).contains("positive"));
+    assert!(err(Element::planar_hinge(1.0)
+        .unwrap()
+        .with_periodic_deformation(0, 1.0))
+    .contains("only a custom element"));
+}
+
+/// In a mechanism the kinematics passes the last solution as `prev`: a bar
+/// whose custom direction is its DOF turns to 5π (two and a half turns) in
+/// steps, its tip where the angle puts it; without the declaration the
+/// solve cannot reach an angle beyond π.
+#[test]
+fn a_custom_hinge_angle_as_a_dof_turns_through_many_revolutions() {
+    let build = |periodic: bool| {
+        let scene = Scene::from_ron_str(
+            r#"(
+        dimension: Planar,
+        nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [1.0, 0.0]) ],
+        elements: [ (id: "rod", type: Truss(nodes: ("A", "B"), ea: 1.0e6, mass_per_length: 1.0)) ],
+        fixed: [ Node("A") ],
+        rigid: [ Def("rod", "*") ],
+        dofs: Explicit([Def("dir", "angle")]),
+    )"#,
+        )
+        .unwrap();
+        let dir = CodeElement {
+            id: "dir".into(),
+            element: direction(periodic),
+            nodes: vec!["A".into(), "B".into()],
+        };
+        Arc::new(scene.build_with_elements(None, &[dir]).unwrap())
+    };
+    let mech = build(true);
+    let mut k = Kinematics::new(mech.clone());
+    let b = mech.node("B").unwrap().position.clone();
+    for step in 1..=50 {
+        let a = 0.1 * std::f64::consts::PI * step as f64;
+        k.solve(&[a], 0.0).unwrap();
+        let (x, y) = (k.x()[b[0]], k.x()[b[1]]);
+        assert!(
+            (x - a.cos()).abs() < 1e-10 && (y - a.sin()).abs() < 1e-10,
+            "at {a}: B = ({x}, {y})"
+        );
+    }
+    let mech = build(false);
+    let mut k = Kinematics::new(mech);
+    let reached = (1..=50).take_while(|s| {
+        k.solve(&[0.1 * std::f64::consts::PI * *s as f64], 0.0)
+            .is_ok()
+    });
+    assert!(reached.count() <= 10, "an angle beyond π was reached");
+}

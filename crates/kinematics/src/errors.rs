@@ -93,6 +93,19 @@ impl Kinematics {
         }
     }
 
+    /// The dependent coordinates that J at the current configuration
+    /// determines worst: those with a large share in its smallest singular
+    /// value's right singular vector (a dense SVD up to `DENSE_UP_TO` rows),
+    /// or the column of the smallest pivot of a large sparse factorization.
+    /// For reports on a configuration near a singular one; J must have been
+    /// factorized there (a solve does it).
+    pub fn least_determined_coordinates(&self) -> Vec<String> {
+        match self.singular_error() {
+            KinematicsError::Singular { coordinates, .. } => coordinates,
+            _ => unreachable!("singular_error gives Singular"),
+        }
+    }
+
     /// The dependent coordinates with a large share in J's null vector (its
     /// smallest singular value's right singular vector).
     fn null_space_names(&self) -> Vec<String> {

@@ -6,7 +6,7 @@
 use crate::{undamped_modes_until, LinearizeError, Modes};
 use faer::Mat;
 use flexmb_dynamics::{short_number, Dynamics, DynamicsError, StaticOptions};
-use flexmb_model::{ChartSwitch, Mechanism};
+use flexmb_model::{ChartSwitch, Mechanism, PartitionSwitch};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -58,6 +58,10 @@ pub struct SweepPoint {
     /// [`SweepParameter::Path`], in their order), from the static
     /// out-of-balance at the equilibrium; empty for a load sweep.
     pub holding: Vec<f64>,
+    /// The nodal coordinates of the equilibrium (the configuration the
+    /// static solve converged to: a position solve from q alone, from
+    /// another starting guess, can land on another branch).
+    pub x: Vec<f64>,
     /// Undamped eigenfrequencies (Hz).
     pub frequencies_hz: Vec<f64>,
     /// Mode shapes (if kept), in the DOFs of [`q`](Self::q).
@@ -133,6 +137,12 @@ pub struct SweepOutcome {
     /// the configuration whose equilibrium switched it. The points' q,
     /// shapes and masses are still in the chart of the sweep's mechanism.
     pub chart_switches: Vec<(usize, ChartSwitch)>,
+    /// The changes of the dependent nodal coordinates the static solves
+    /// made (nodal DOFs whose dependent set got ill-conditioned,
+    /// [`flexmb_dynamics::StaticSolution::partition_switches`]), each with
+    /// the index of its configuration. The points are still given in the
+    /// DOFs of the sweep's mechanism.
+    pub partition_switches: Vec<(usize, PartitionSwitch)>,
     /// The Newton iterations of the equilibria, in all
     /// ([`flexmb_dynamics::StaticSolution::iterations`]).
     pub iterations: usize,
@@ -170,6 +180,7 @@ pub fn sweep_until(
     // an orientation that turned far, and the continuation goes on in it
     let mut charts: Vec<Arc<Mechanism>> = Vec::with_capacity(n);
     let mut chart_switches = vec![];
+    let mut partition_switches = vec![];
     let mut iterations = 0;
     // the equilibria since the last chart switch or failed extrapolation,
     // (s, q), at most the last three: the starting guess of the next one
@@ -177,7 +188,12 @@ pub fn sweep_until(
     // phase 1: equilibria by continuation
     for (i, &s) in opts.values.iter().enumerate() {
         if requested(stop) {
-            return Ok(stopped_early(i, chart_switches, iterations));
+            return Ok(stopped_early(
+                i,
+                chart_switches,
+                partition_switches,
+                iterations,
+            ));
         }
         // the first equilibrium ramps the loads; the next ones continue from it
         let mut so = StaticOptions {
@@ -225,13 +241,18 @@ pub fn sweep_until(
         let sol = match solved {
             Ok(sol) => sol,
             Err(DynamicsError::Interrupted) => {
-                return Ok(stopped_early(i, chart_switches, iterations))
+                return Ok(stopped_early(
+                    i,
+                    chart_switches,
+                    partition_switches,
+                    iterations,
+                ))
             }
             Err(e) => return Err(failed_at(mech, param, opts, i, e.to_string())),
         };
         iterations += sol.iterations;
-        if !sol.chart_switches.is_empty() {
-            // the earlier equilibria are in other charts
+        if !sol.chart_switches.is_empty() || !sol.partition_switches.is_empty() {
+            // the earlier equilibria are in other charts or DOFs
             recent.clear();
         }
         if recent.len() == 3 {
@@ -243,6 +264,7 @@ pub fn sweep_until(
         xs.push(sol.x);
         charts.push(dy.mechanism().clone());
         chart_switches.extend(sol.chart_switches.into_iter().map(|c| (i, c)));
+        partition_switches.extend(sol.partition_switches.into_iter().map(|c| (i, c)));
         holding.push(sol.reactions);
         progress(i + 1, total);
     }
@@ -304,6 +326,7 @@ pub fn sweep_until(
                 s: opts.values[i],
                 q,
                 holding: holding[i].clone(),
+                x: xs[i].clone(),
                 frequencies_hz: modes.frequencies_hz(),
                 modes: opts.keep_vectors.then(|| modes.vectors.clone()),
                 mass: opts.keep_vectors.then_some(m),
@@ -315,6 +338,7 @@ pub fn sweep_until(
         points,
         equilibria: n,
         chart_switches,
+        partition_switches,
         iterations,
     })
 }
@@ -345,8 +369,9 @@ fn in_sweep_chart(
     lu.factor(s.as_ref()).map_err(|e| {
         format!(
             "the mass matrix cannot be given in the sweep's degrees of freedom, whose \
-             Euler-parameter chart is singular at this configuration ({e}): sweep a range \
-             that stays within 180° of the start orientation"
+             Euler-parameter chart or dependent nodal coordinates are singular at this \
+             configuration ({e}): sweep a range that stays within 180° of the start \
+             orientation, or use deformations as DOFs"
         )
     })?;
     // S⁻ᵀ M, then (S⁻ᵀ (S⁻ᵀ M)ᵀ)ᵀ = S⁻ᵀ M S⁻¹ (M symmetric)
@@ -361,6 +386,7 @@ fn in_sweep_chart(
 fn stopped_early(
     equilibria: usize,
     chart_switches: Vec<(usize, ChartSwitch)>,
+    partition_switches: Vec<(usize, PartitionSwitch)>,
     iterations: usize,
 ) -> SweepOutcome {
     SweepOutcome {
@@ -368,6 +394,7 @@ fn stopped_early(
         equilibria,
         stopped: true,
         chart_switches,
+        partition_switches,
         iterations,
     }
 }

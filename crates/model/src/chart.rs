@@ -55,7 +55,7 @@ impl EulerChart {
 /// A chart switch that happened: for reports.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChartSwitch {
-    /// Time of the switch.
+    /// Time of the switch (the load factor, in a static solve).
     pub t: f64,
     /// The node.
     pub node: String,

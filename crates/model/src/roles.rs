@@ -27,10 +27,13 @@ pub(crate) use memory::{check_dense, human_bytes, physical_memory};
 pub(crate) use selection::resolve;
 use sparse::{choose_sparse, Blocks};
 
+/// A sparse matrix by rows: each row's nonzero entries (column, value).
+pub(crate) type SparseRows = Vec<Vec<(usize, f64)>>;
+
 /// The global deformation Jacobian D,x at x, sparse: for every deformation its
 /// nonzero entries (global nodal index, value), sorted by index. Entries of one
 /// index are summed in element order, as a dense assembly would.
-pub(crate) fn sparse_jacobian(mech: &Mechanism, x: &[f64]) -> Vec<Vec<(usize, f64)>> {
+pub(crate) fn sparse_jacobian(mech: &Mechanism, x: &[f64]) -> SparseRows {
     let mut rows: Vec<Vec<(usize, f64)>> = vec![vec![]; mech.n_eps()];
     let mut xl = vec![];
     let mut eps = vec![];
@@ -416,11 +419,30 @@ pub(crate) fn mark(scene: &Scene, mech: &mut Mechanism) -> Result<(Vec<R>, Vec<R
     Ok((xr, er))
 }
 
+/// The roles of every coordinate and deformation of `mech` (thesis (6.4),
+/// (D.3)), in three stages: the roles the scene states ([`mark`]), the
+/// choice of the DOFs among the free ones ([`choose_dofs`]) with the
+/// dependent coordinates and constraint rows that follow ([`apply_roles`]),
+/// and the check that the equations determine the dependent coordinates
+/// ([`check_dependent_regular`]).
 pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelError> {
+    let (mut xr, mut er) = mark(scene, mech)?;
+    let (chosen, rows, method) = choose_dofs(scene, mech, &xr, &er)?;
+    apply_roles(mech, chosen, &mut xr, &mut er)?;
+    check_dependent_regular(mech, &rows, method)
+}
+
+/// The DOFs chosen among the free coordinates at the reference
+/// configuration (the greedy of the module docs, dense or sparse by size),
+/// with the sparse constraint Jacobian there and the method used.
+fn choose_dofs(
+    scene: &Scene,
+    mech: &Mechanism,
+    xr: &[R],
+    er: &[R],
+) -> Result<(Vec<Coordinate>, SparseRows, Method), ModelError> {
     let n_x = mech.n_x();
     let n_eps = mech.n_eps();
-    let (mut xr, mut er) = mark(scene, mech)?;
-    // ---- the constraint Jacobian at the reference configuration, and the DOFs
     let free: Vec<usize> = (0..n_x).filter(|i| xr[*i] == R::Free).collect();
     let mut free_pos = vec![usize::MAX; n_x];
     for (k, i) in free.iter().enumerate() {
@@ -431,8 +453,8 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
         .collect();
     let problem = Problem {
         mech,
-        xr: &xr,
-        er: &er,
+        xr,
+        er,
         free,
         free_pos,
         crow,
@@ -447,8 +469,21 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
         Method::Sparse | Method::Blocks => choose_sparse(scene, &problem, method)?,
         _ => choose_dense(scene, &problem)?,
     };
-    let rows = problem.rows;
-    // ---- roles
+    Ok((chosen, problem.rows, method))
+}
+
+/// Gives the chosen DOFs their roles, the remaining free coordinates the
+/// dependent ones and the rigid, DOF and prescribed deformations the
+/// constraint rows; as many equations as dependent coordinates, or an
+/// error.
+fn apply_roles(
+    mech: &mut Mechanism,
+    chosen: Vec<Coordinate>,
+    xr: &mut [R],
+    er: &mut [R],
+) -> Result<(), ModelError> {
+    let n_x = mech.n_x();
+    let n_eps = mech.n_eps();
     for (k, c) in chosen.iter().enumerate() {
         match *c {
             Coordinate::Node(i) => xr[i] = R::Rigid, // marker: DOF
@@ -495,15 +530,25 @@ pub(crate) fn assign(scene: &Scene, mech: &mut Mechanism) -> Result<(), ModelErr
             ),
         ));
     }
-    // ---- final regularity check of the Jacobian of the equations w.r.t. the
-    // dependent coordinates. The sparse method implies it: the equations and
-    // the chosen DOFs are n_free independent rows over the free coordinates
-    // (every one accepted with a residual), and the DOFs among the nodal
-    // coordinates are unit rows, so the rest is regular on the dependent ones.
-    // In exact arithmetic, that is: numerically the check still finds an
-    // equation that depends on the free coordinates only through rounding
-    // errors (its normalized row is noise). Up to DENSE_MAX_DEPENDENT the SVD
-    // does it, above Gram–Schmidt on the blocks of the unnormalized rows.
+    Ok(())
+}
+
+/// The final regularity check of the Jacobian of the equations w.r.t. the
+/// dependent coordinates (`rows`: the sparse constraint Jacobian at the
+/// reference). The sparse method implies it: the equations and the chosen
+/// DOFs are n_free independent rows over the free coordinates (every one
+/// accepted with a residual), and the DOFs among the nodal coordinates are
+/// unit rows, so the rest is regular on the dependent ones. In exact
+/// arithmetic, that is: numerically the check still finds an equation that
+/// depends on the free coordinates only through rounding errors (its
+/// normalized row is noise). Up to DENSE_MAX_DEPENDENT the SVD does it,
+/// above Gram–Schmidt on the blocks of the unnormalized rows.
+fn check_dependent_regular(
+    mech: &Mechanism,
+    rows: &[Vec<(usize, f64)>],
+    method: Method,
+) -> Result<(), ModelError> {
+    let n_x = mech.n_x();
     let nd = mech.dependent.len();
     let mut dep_pos = vec![usize::MAX; n_x];
     for (k, i) in mech.dependent.iter().enumerate() {

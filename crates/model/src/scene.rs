@@ -17,6 +17,16 @@ pub enum Dimension {
     Spatial,
 }
 
+impl Dimension {
+    /// Position coordinates of a node: 2 (planar) or 3 (spatial).
+    pub fn position_len(self) -> usize {
+        match self {
+            Dimension::Planar => 2,
+            Dimension::Spatial => 3,
+        }
+    }
+}
+
 /// A material: E, ρ, and either G or Poisson's ratio ν.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
