@@ -21,6 +21,7 @@
 
 pub mod component;
 pub mod mechanism;
+pub mod response;
 
 use crate::curves::StoredCurve;
 use crate::models::{quasi_static_curve_of, CurvePoint, Model, ModelKind};

@@ -11,6 +11,7 @@ mod mechanism;
 
 use crate::ch3::component as comp;
 use crate::ch3::mechanism::{self as mech, Files, MechOptions};
+use crate::ch3::response as resp;
 use crate::ch3::{self, Ch3Options, Kind};
 use crate::models::{CurvePoint, Start};
 use crate::progress::Progress;
@@ -85,12 +86,12 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
     };
     // the two time responses with the thesis's integrator take longest: each
     // on a thread of its own while the rest runs
-    let adams = mech::simulation_options(mo.t_end, mo.dt, 1e-3);
+    let adams = resp::simulation_options(mo.t_end, mo.dt, 1e-3);
     let (run_i, run_ii, rest) = std::thread::scope(|sc| {
-        let i = sc.spawn(|| mech::run_with_bar(out, &files, Start::Reference, &adams, pg));
-        let ii = sc.spawn(|| mech::run_with_bar(out, &files, Start::Equilibrium, &adams, pg));
+        let i = sc.spawn(|| resp::run_with_bar(out, &files, Start::Reference, &adams, pg));
+        let ii = sc.spawn(|| resp::run_with_bar(out, &files, Start::Equilibrium, &adams, pg));
         let rest = the_rest(root, out, &mo, &geometry, &segments, &files, pg);
-        let join = |h: std::thread::ScopedJoinHandle<'_, Result<mech::Run, String>>| {
+        let join = |h: std::thread::ScopedJoinHandle<'_, Result<resp::Run, String>>| {
             h.join()
                 .unwrap_or_else(|_| Err("a time response panicked".into()))
         };
@@ -119,11 +120,11 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
     };
     let solid = ch3::read_solid(root)?;
     let veer_solid = read_veering_solid(root)?;
-    let cl = mech::response_claims(
+    let cl = resp::response_claims(
         &run_i,
         &run_ii,
-        &mech::omega2_of(&rest.sweep.value),
-        mech::WINDOW,
+        &resp::omega2_of(&rest.sweep.value),
+        resp::WINDOW,
     );
     let extreme_phis: Vec<f64> = cl.phi_extremes.iter().take(2).map(|e| e.1).collect();
     let at_extremes = mech::at_rotations(out, &files, true, &extreme_phis)?;
@@ -174,7 +175,7 @@ struct Rest {
     sweep: Timed<Vec<CurvePoint>>,
     at_solid: Timed<Vec<mech::AtRotation>>,
     table_3_3: Timed<Vec<mech::AtRotation>>,
-    check: Timed<mech::Run>,
+    check: Timed<resp::Run>,
     converged: Timed<Vec<f64>>,
 }
 
@@ -236,11 +237,11 @@ fn the_rest(
                 || {
                     rayon::join(
                         || {
-                            let mut ga = mech::simulation_options(mo.t_end, mo.dt, 1e-5);
+                            let mut ga = resp::simulation_options(mo.t_end, mo.dt, 1e-5);
                             ga.integrator = flexmb_dynamics::Integrator::GeneralizedAlpha;
                             tick(
                                 &bar,
-                                timed(|| mech::run(out, files, Start::Equilibrium, &ga, &|_| {})),
+                                timed(|| resp::run(out, files, Start::Equilibrium, &ga, &|_| {})),
                             )
                         },
                         || {

@@ -1,7 +1,8 @@
 //! Chapter 3 §3.5.3's claims on the small compliant mechanism (Figs
-//! 3.13–3.16, Tables 3.2, 3.3), with the flexures on the stored curves' mesh
-//! (`xtask::ch3::CURVE_MESH`) and the component of §3.5.2 with six normal
-//! modes:
+//! 3.13–3.16, Tables 3.2, 3.3), with the flexures on the thesis's quarter
+//! mesh (10 × 40 × 4, as `cargo xtask reproduce ch3`: the stored curves'
+//! coarse mesh is 1.6 % stiffer in the hinge's moment) and the component of
+//! §3.5.2 with six normal modes:
 //! - 60 DOF; ±0.6 N m turn it by about ±30°; ω2 ≈ 40 Hz at rest;
 //! - its frequencies and moments along ±30° follow the stored CalculiX
 //!   solid of the same mechanism;
@@ -12,8 +13,9 @@
 //!   latter's z departs at the extremes of ϕ, near 0.12 and 0.26 s.
 
 use std::path::PathBuf;
+use xtask::ch3::component as comp;
 use xtask::ch3::mechanism::{self as mech, Files, Moment};
-use xtask::ch3::{component as comp, CURVE_MESH};
+use xtask::ch3::response as resp;
 use xtask::models::Start;
 
 /// The superelements of the mechanism, built once per test binary.
@@ -28,9 +30,10 @@ fn built() -> &'static (PathBuf, Files) {
         let r = flexmb_superelement::build(&model, &s).unwrap();
         std::fs::create_dir_all(&dir).unwrap();
         flexmb_superelement::spec::write_ron(&dir.join(comp::file_of(6)), &r.data).unwrap();
-        let f = mech::build_flexures(&dir, CURVE_MESH, 4).unwrap();
+        let o = mech::MechOptions::default();
+        let f = mech::build_flexures(&dir, o.mesh, o.segments).unwrap();
         let files = Files {
-            segments: 4,
+            segments: o.segments,
             flexure_a: f[0].file.clone(),
             flexure_b: f[1].file.clone(),
             component: comp::file_of(6),
@@ -109,8 +112,11 @@ fn the_mechanism_follows_the_solid_along_the_stroke() {
 
 /// Table 3.3: node 7's static z under gravity at ϕ = 0 and ±30° (ours; the
 /// thesis's ϕ is reversed). It sags least at rest and most at +30°, as in
-/// the stored solid; each value within 5 % of the solid's (0.06 % at rest,
-/// 3 % at −30° measured: the hinge's stiffness at large ϕ, see above).
+/// the stored solid. At rest within 1 % of the solid (0.06 % measured). What
+/// the deflection adds, z(±30°) − z(0), is the deflected sheets' torsion and
+/// out-of-plane compliance: within 10 % of the solid's (6.2 % and 7.5 %
+/// measured), as SE-CW has the sheet's torsion frequency within 3.5 % of the
+/// solid along §3.5.1's ±40°, i.e. its stiffness within 7 %.
 #[test]
 fn node_7_sags_most_at_one_end_of_the_stroke() {
     let root = xtask::workspace_root();
@@ -118,19 +124,31 @@ fn node_7_sags_most_at_one_end_of_the_stroke() {
     let (dir, files) = built();
     let se = mech::at_rotations(dir, files, true, &[0.0, -30.0, 30.0]).unwrap();
     let z: Vec<f64> = se.iter().map(|p| p.z7).collect();
-    eprintln!("z7 at 0, -30, +30°: {z:?}");
+    let fe: Vec<f64> = se
+        .iter()
+        .map(|p| {
+            solid
+                .iter()
+                .find(|q| q.phi == p.target)
+                .expect("a solid point at each ϕ")
+                .z7
+        })
+        .collect();
+    eprintln!("z7 at 0, -30, +30°: {z:?}, solid {fe:?}");
     assert!(z[2] < z[1] && z[1] < z[0] && z[0] < 0.0, "{z:?}");
-    for p in &se {
-        let q = solid
-            .iter()
-            .find(|q| q.phi == p.target)
-            .expect("a solid point at each ϕ");
+    assert!(fe[2] < fe[1] && fe[1] < fe[0] && fe[0] < 0.0, "{fe:?}");
+    assert!(
+        (z[0] / fe[0] - 1.0).abs() < 0.01,
+        "at rest: {} against {}",
+        z[0],
+        fe[0]
+    );
+    for k in [1, 2] {
+        let (a, b) = (z[k] - z[0], fe[k] - fe[0]);
         assert!(
-            (p.z7 / q.z7 - 1.0).abs() < 0.05,
-            "ϕ = {}°: {} against the solid's {}",
-            p.target,
-            p.z7,
-            q.z7
+            (a / b - 1.0).abs() < 0.1,
+            "ϕ = {}°: the deflection adds {a}, in the solid {b}",
+            se[k].target
         );
     }
 }
@@ -144,10 +162,10 @@ fn node_7_sags_most_at_one_end_of_the_stroke() {
 #[test]
 fn the_time_responses_show_the_40_hz_oscillation_and_the_periodic_difference() {
     let (dir, files) = built();
-    let mut ga = mech::simulation_options(0.3, 5e-4, 1e-5);
+    let mut ga = resp::simulation_options(0.3, 5e-4, 1e-5);
     ga.integrator = flexmb_dynamics::Integrator::GeneralizedAlpha;
-    let ii = mech::run(dir, files, Start::Equilibrium, &ga, &|_| {}).unwrap();
-    let ext = mech::extremes(&ii.t, &ii.phi);
+    let ii = resp::run(dir, files, Start::Equilibrium, &ga, &|_| {}).unwrap();
+    let ext = resp::extremes(&ii.t, &ii.phi);
     eprintln!("run (ii): extremes of ϕ {ext:?}");
     assert!(ext.len() >= 2);
     let (max, min) = (ext[0], ext[1]);
@@ -170,10 +188,10 @@ fn the_time_responses_show_the_40_hz_oscillation_and_the_periodic_difference() {
         z(min.0)
     );
     // run (i), the first 0.05 s with the thesis's integrator
-    let adams = mech::simulation_options(mech::WINDOW, 5e-4, 1e-3);
-    let i = mech::run(dir, files, Start::Reference, &adams, &|_| {}).unwrap();
+    let adams = resp::simulation_options(resp::WINDOW, 5e-4, 1e-3);
+    let i = resp::run(dir, files, Start::Reference, &adams, &|_| {}).unwrap();
     let sweep = mech::sweep(dir, files, 41).unwrap();
-    let c = mech::response_claims(&i, &ii, &mech::omega2_of(&sweep), mech::WINDOW);
+    let c = resp::response_claims(&i, &ii, &resp::omega2_of(&sweep), resp::WINDOW);
     let w = c.windows[0];
     eprintln!("run (i) - run (ii): {c:?}");
     assert!(

@@ -5,9 +5,10 @@
 
 use super::{io, Timed};
 use crate::ch3::mechanism::{
-    self as mech, AtRotation, BuiltSegment, Files, MechOptions, Run, SolidPoint, M_MAX, N_FREQ,
-    PULSE, TABLE_3_3, TABLE_3_3_PHI,
+    self as mech, AtRotation, BuiltSegment, Files, MechOptions, SolidPoint, M_MAX, N_FREQ, PULSE,
+    TABLE_3_3, TABLE_3_3_PHI,
 };
+use crate::ch3::response::{self as resp, Run};
 use crate::models::CurvePoint;
 use crate::report::{Figures, Table};
 use flexmb_plot::{Plot, Series};
@@ -326,14 +327,14 @@ fn table_3_3(c: &Computed) -> String {
         ]);
     }
     let _ = writeln!(s, "{}", t.render());
-    let _ = writeln!(s, "The thesis's SE model is 4–10 % softer than its FE model (\"agree qualitatively well\"); ours agrees with our solid to the figures above. Both of ours sag more at ϕ = 0 than the thesis's models (the component is our design, and its first frequency was set near the thesis's 41.4 Hz, not its sag).\n");
+    let _ = writeln!(s, "The thesis's SE model sags 4–10 % less than its FE model (\"agree qualitatively well\"); ours and our solid are compared in the last column. Ours sag more at ϕ = 0 than the thesis's models: the component is our design, fitted to the thesis's first frequency (41.4 Hz), not to its sag.\n");
     s
 }
 
 fn response(c: &Computed) -> String {
     let mut s = String::new();
     let [ri, rii] = &c.runs;
-    let cl = mech::response_claims(ri, rii, &mech::omega2_of(&c.sweep.value), mech::WINDOW);
+    let cl = resp::response_claims(ri, rii, &resp::omega2_of(&c.sweep.value), resp::WINDOW);
     let _ = writeln!(s, "### Time responses (Figs 3.15, 3.16)\n");
     let _ = writeln!(s, "M(t) of (3.38), M_max = {} N m, T = {} s, gravity; {} s, outputs every {} ms; Adams (the thesis's Shampine–Gordon type) at rtol 1e-3, atol 1e-6 (not stated in the thesis; ode113's defaults). Run (i) from the undeflected configuration: {} evaluations, {:.0} s; run (ii) from the gravity equilibrium: {} evaluations, {:.0} s (`curves/mechanism_response.csv`). The step is set by the flexures' stiff in-plane modes, not by the tolerance: the unreduced model is the one the thesis calls too slow.\n",
         PULSE.0, PULSE.1, c.options.t_end, 1e3 * c.options.dt, ri.evaluations, ri.wall_time, rii.evaluations, rii.wall_time);
@@ -374,7 +375,7 @@ fn response(c: &Computed) -> String {
     }
     let _ = writeln!(s, "{}", t.render());
     let _ = writeln!(s, "The oscillation follows ω2 of the deflected mechanism, which drops to about 31 Hz at ±30° (Fig. 3.14a): per window of {} s, the frequency of run (i) − run (ii) against the mean of ω2 at run (i)'s ϕ(t) over the window: {}.\n",
-        mech::WINDOW,
+        resp::WINDOW,
         cl.windows.iter().map(|w| format!("{:.2}–{:.2} s: {:.1} Hz / {:.1} Hz", w.0, w.1, w.2, w.3)).collect::<Vec<_>>().join("; "));
     let _ = writeln!(s, "Run (ii) starts at z7 = {:.3e} m, the static sag at ϕ = 0. Its \"periodic difference\" is the sag following ϕ: at each extreme of ϕ, z7 is near the static sag at that ϕ ({}), more at ϕ > 0 than at ϕ < 0 — the asymmetry of Table 3.3 (\"caused by the non-symmetrical layout\").\n",
         cl.z7_start,
