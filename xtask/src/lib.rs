@@ -10,16 +10,19 @@ pub mod ch3;
 pub mod ch4;
 pub mod ch5;
 pub mod ch6;
+pub mod ch7;
 pub mod curves;
 pub mod fuzz;
 pub mod models;
 pub mod pictures;
+pub mod pictures3;
 pub mod progress;
 pub mod regress;
 pub mod report;
 pub mod reproduce3;
 pub mod reproduce4;
 pub mod reproduce6;
+pub mod reproduce7;
 pub mod solid6;
 
 /// The workspace root (the parent of this crate).

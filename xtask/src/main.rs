@@ -1,4 +1,4 @@
-//! `cargo xtask reproduce ch2|ch3|ch4|ch5|ch6|all`, `cargo xtask regress` and `cargo xtask fuzz`.
+//! `cargo xtask reproduce ch2|ch3|ch4|ch5|ch6|ch7|all`, `cargo xtask regress` and `cargo xtask fuzz`.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -23,6 +23,7 @@ enum Chapter {
     Ch4,
     Ch5,
     Ch6,
+    Ch7,
     All,
 }
 
@@ -40,7 +41,7 @@ enum FuzzTarget {
 enum Cmd {
     /// Regenerate a chapter's results into OUT/chN (CSV, SVG, report.md).
     Reproduce {
-        /// ch2, ch3, ch4, ch5, ch6 or all.
+        /// ch2, ch3, ch4, ch5, ch6, ch7 or all.
         chapter: Chapter,
         /// Output directory.
         #[arg(long, default_value = "results")]
@@ -232,6 +233,15 @@ fn reproduce(
             out.join("ch6/report.md").display()
         ));
         summary.extend(rows.iter().map(xtask::reproduce6::summary_line));
+    }
+    if matches!(ch, Chapter::Ch7 | Chapter::All) {
+        let t = std::time::Instant::now();
+        xtask::reproduce7::reproduce(root, &out.join("ch7"), pg)?;
+        summary.push(format!(
+            "chapter 7 in {:.0} s: {}",
+            t.elapsed().as_secs_f64(),
+            out.join("ch7/report.md").display()
+        ));
     }
     for l in summary {
         println!("{l}");

@@ -60,28 +60,40 @@ pub fn guidance(
             ..Default::default()
         },
     )?;
-    let mut freqs = vec![];
-    for k in 1..=modes {
-        let mut f = [0.0; 2];
-        let at_x = [(&rest, "x0", "x = 0"), (&max, "xmax", "x max")];
-        for (j, (at, tag, name)) in at_x.into_iter().enumerate() {
-            f[j] = save(
-                figs,
-                out,
-                &format!("mech_mode{k}_{tag}"),
-                at,
-                &DrawOptions {
-                    mode: Some(k),
-                    phases: Some(2),
-                    title: Some(format!("Guidance at {name}")),
-                    ..Default::default()
-                },
-            )?
-            .unwrap_or(f64::NAN);
+    let at_x = [
+        (&rest, "x0", "Guidance at x = 0".to_string()),
+        (&max, "xmax", "Guidance at x max".to_string()),
+    ];
+    let modes: Vec<usize> = (1..=modes).collect();
+    let f = mode_pictures(figs, out, &modes, &at_x)?;
+    Ok((0..modes.len()).map(|k| (f[0][k], f[1][k])).collect())
+}
+
+/// Draws modes `modes` at each configuration of `ats` (configuration, file
+/// tag, title) as `mech_mode{k}_{tag}`, mode by mode (each mode's pictures
+/// side by side in a report): two phases at ±10 % of the mechanism's size.
+/// Returns the frequencies drawn (Hz), per configuration and mode.
+pub fn mode_pictures(
+    figs: &mut Figures,
+    out: &Path,
+    modes: &[usize],
+    ats: &[(&Configuration, &str, String)],
+) -> io::Result<Vec<Vec<f64>>> {
+    let mut f = vec![vec![f64::NAN; modes.len()]; ats.len()];
+    for (j, &k) in modes.iter().enumerate() {
+        for (i, (at, tag, title)) in ats.iter().enumerate() {
+            let opts = DrawOptions {
+                mode: Some(k),
+                phases: Some(2),
+                title: Some(title.clone()),
+                ..Default::default()
+            };
+            if let Some(hz) = save(figs, out, &format!("mech_mode{k}_{tag}"), at, &opts)? {
+                f[i][j] = hz;
+            }
         }
-        freqs.push((f[0], f[1]));
     }
-    Ok(freqs)
+    Ok(f)
 }
 
 /// The report section of the pictures of [`guidance`]: what they show, the

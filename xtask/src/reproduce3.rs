@@ -150,6 +150,12 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
     let s2 = component::section(&component, &rest.converged, &component_solid);
     let s3 = mechanism::section(out, &mechanism, &mut figs)?;
     let speed = speed_table(&flexure, &solid, &component, &component_solid, &mechanism);
+    let drawn = crate::pictures3::draw(
+        out,
+        ch3::segment_file(Kind::SeCw, &flexure.segments),
+        out,
+        &mut figs,
+    )?;
     let wall = start.elapsed().as_secs_f64();
     let _ = writeln!(
         md,
@@ -161,11 +167,12 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
         rayon::current_num_threads()
     );
     md.push_str(&s1);
+    md.push_str(&crate::pictures3::section(&figs, &drawn));
     md.push_str(&s2);
     md.push_str(&s3);
     md.push_str(&speed);
     let _ = writeln!(md, "## Figures\n");
-    let _ = writeln!(md, "{}", figs.markdown(|_| true));
+    let _ = writeln!(md, "{}", figs.markdown(|f| !f.starts_with("mech_")));
     std::fs::write(out.join("report.md"), md).map_err(io)
 }
 

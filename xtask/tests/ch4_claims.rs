@@ -29,6 +29,7 @@ fn the_committed_model_is_the_generators() {
         xtask::ch4::SCENE_FILE,
         xtask::ch4::SKELETON_FILE,
         xtask::ch4::SKELETON_RIGID_FILE,
+        xtask::ch4::ACTUATED_SCENE_FILE,
     ] {
         let new = std::fs::read_to_string(dir.join(f)).unwrap();
         let old = std::fs::read_to_string(fixtures.join(f)).unwrap();

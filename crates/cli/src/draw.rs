@@ -39,6 +39,11 @@ pub(crate) struct DrawArgs {
     /// Overlay the reference configuration in light grey.
     #[arg(long)]
     reference: bool,
+    /// Draw beams as lines between their nodes and superelements as their
+    /// chord, not as thin boxes of their section and the outline of their
+    /// FE mesh.
+    #[arg(long)]
+    lines: bool,
     /// iso, xy, xz or yz [default: xy for planar scenes, iso for spatial].
     #[arg(long)]
     view: Option<String>,
@@ -94,6 +99,11 @@ pub(crate) fn draw(a: &DrawArgs) -> Result<(), Failure> {
         amplitude: a.amplitude,
         phases: a.phases,
         title: None,
+        style: if a.lines {
+            flexmb_draw::Style::Lines
+        } else {
+            flexmb_draw::Style::Outline
+        },
     };
     let pic = flexmb_draw::picture(&at, &opts).map_err(failure)?;
     pic.save(&a.out).map_err(failure)?;

@@ -20,6 +20,7 @@ mod path;
 mod reduce;
 mod reduced;
 mod report;
+mod superelement;
 mod vtk_out;
 
 use clap::{Args, Parser, Subcommand};
@@ -44,7 +45,7 @@ use std::sync::Arc;
     version,
     about = "Flexible multibody dynamics and model reduction for compliant mechanisms",
     long_about = "Flexible multibody dynamics and model reduction for compliant mechanisms.\n\nScenes are RON files (see docs/scene-format.md); examples are in fixtures/scenes/.",
-    after_help = "Examples:\n  flexmb info fixtures/scenes/straight_guidance_spatial.ron\n  flexmb static fixtures/scenes/straight_guidance_spatial.ron --out results/static\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --t-end 0.5 --out results/sim\n  flexmb simulate fixtures/scenes/spin_up_planar.ron --t-end 20 --integrator adams --rtol 1e-6\n  flexmb reduce fixtures/scenes/straight_guidance_planar.ron --method modal --modes 3 --out modal3.ron\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --reduced modal3.ron --t-end 0.5\n  flexmb build-superelement spec.ron"
+    after_help = "Examples:\n  flexmb info fixtures/scenes/straight_guidance_spatial.ron\n  flexmb static fixtures/scenes/straight_guidance_spatial.ron --out results/static\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --t-end 0.5 --out results/sim\n  flexmb simulate fixtures/scenes/spin_up_planar.ron --t-end 20 --integrator adams --rtol 1e-6\n  flexmb reduce fixtures/scenes/straight_guidance_planar.ron --method modal --modes 3 --out modal3.ron\n  flexmb simulate fixtures/scenes/straight_guidance_planar.ron --reduced modal3.ron --t-end 0.5\n  flexmb build-superelement spec.ron\n  flexmb build-superelement --mesh part.geo --material steel --interface p=left --interface q=plane:x=0.1 --out results/part"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -83,10 +84,9 @@ enum Command {
         /// this directory.
         #[arg(long, value_name = "DIR")]
         vtk: Option<PathBuf>,
-        /// With --vtk: draw superelements as the chord between their nodes,
-        /// not as their FE mesh (smaller files for large meshes).
-        #[arg(long, requires = "vtk")]
-        vtk_chords: bool,
+        /// How --vtk draws superelements and beams.
+        #[command(flatten)]
+        vtk_style: vtk_out::VtkStyle,
     },
     /// Time response from the reference configuration (or from equilibrium with --static-first).
     Simulate(SimulateArgs),
@@ -109,10 +109,9 @@ enum Command {
         /// (mode_K.pvd) as VTK to this directory.
         #[arg(long, value_name = "DIR")]
         vtk: Option<PathBuf>,
-        /// With --vtk: draw superelements as the chord between their nodes,
-        /// not as their FE mesh (smaller files for large meshes).
-        #[arg(long, requires = "vtk")]
-        vtk_chords: bool,
+        /// How --vtk draws superelements and beams.
+        #[command(flatten)]
+        vtk_style: vtk_out::VtkStyle,
     },
     /// Eigenfrequencies along the range of motion: over a load scale or a
     /// held coordinate, n equilibria, eigen analyses in parallel.
@@ -123,11 +122,13 @@ enum Command {
     /// Draw the mechanism (reference, static equilibrium or a state) and its
     /// mode shapes as SVG or PNG (see docs/cli.md).
     Draw(draw::DrawArgs),
-    /// Build a linear superelement from FE matrices (see crates/superelement/README.md).
-    BuildSuperelement {
-        /// Specification file (RON).
-        spec: PathBuf,
-    },
+    /// Build a linear superelement: from FE matrices named in a spec file
+    /// (see crates/superelement/README.md), or in one command from a mesh
+    /// (--mesh, see docs/superelement.md).
+    #[command(
+        override_usage = "flexmb build-superelement SPEC.ron\n       flexmb build-superelement --mesh PART.msh|PART.geo|PART.inp --material M --interface p=… --interface q=… [OPTIONS]"
+    )]
+    BuildSuperelement(superelement::SuperelementArgs),
 }
 
 /// Options of `flexmb simulate`.
@@ -165,10 +166,9 @@ struct SimulateArgs {
     /// (simulate.pvd and one VTU file per output) to this directory.
     #[arg(long, value_name = "DIR")]
     vtk: Option<PathBuf>,
-    /// With --vtk: draw superelements as the chord between their nodes,
-    /// not as their FE mesh (smaller files for large meshes).
-    #[arg(long, requires = "vtk")]
-    vtk_chords: bool,
+    /// How --vtk draws superelements and beams.
+    #[command(flatten)]
+    vtk_style: vtk_out::VtkStyle,
 }
 
 /// Options of `flexmb sweep`.
@@ -218,10 +218,9 @@ struct SweepArgs {
     /// this directory.
     #[arg(long, value_name = "DIR")]
     vtk: Option<PathBuf>,
-    /// With --vtk: draw superelements as the chord between their nodes,
-    /// not as their FE mesh (smaller files for large meshes).
-    #[arg(long, requires = "vtk")]
-    vtk_chords: bool,
+    /// How --vtk draws superelements and beams.
+    #[command(flatten)]
+    vtk_style: vtk_out::VtkStyle,
 }
 
 /// Why a command failed, which decides the exit code.
@@ -310,13 +309,13 @@ fn run(command: Command) -> Result<(), Failure> {
             steps,
             out,
             vtk,
-            vtk_chords,
+            vtk_style,
         } => statics(
             &scene,
             time,
             steps,
             &out,
-            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_chords)),
+            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_style)),
         ),
         Command::Simulate(a) => simulate(&a),
         Command::Eig {
@@ -325,18 +324,18 @@ fn run(command: Command) -> Result<(), Failure> {
             static_first,
             buckling,
             vtk,
-            vtk_chords,
+            vtk_style,
         } => eig(
             &scene,
             modes,
             static_first,
             buckling,
-            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_chords)),
+            vtk.as_deref().map(|d| vtk_out::VtkOut::new(d, vtk_style)),
         ),
         Command::Sweep(a) => sweep(&a),
         Command::Reduce(a) => reduce::reduce(&a),
         Command::Draw(a) => draw::draw(&a),
-        Command::BuildSuperelement { spec } => build_superelement(&spec),
+        Command::BuildSuperelement(a) => superelement::build_superelement(&a),
     }
 }
 
@@ -549,7 +548,7 @@ fn simulate(a: &SimulateArgs) -> Result<(), Failure> {
             .map(|(t, x)| (*t, x.as_slice()))
             .collect();
         vtk_out::write(
-            vtk_out::VtkOut::new(d, a.vtk_chords),
+            vtk_out::VtkOut::new(d, a.vtk_style),
             "simulate",
             &mech,
             &frames,
@@ -853,7 +852,7 @@ fn sweep(a: &SweepArgs) -> Result<(), Failure> {
     }
     write_frequency_sweep(&sw, &comments, &a.out)?;
     if let Some(d) = &a.vtk {
-        vtk_out::write_sweep_points(vtk_out::VtkOut::new(d, a.vtk_chords), &mech, a.t_load, &pts)?;
+        vtk_out::write_sweep_points(vtk_out::VtkOut::new(d, a.vtk_style), &mech, a.t_load, &pts)?;
     }
     if outcome.stopped {
         return Err(Failure::Interrupted(format!(
@@ -925,25 +924,4 @@ fn sweep_command_line(a: &SweepArgs) -> String {
         a.n,
         a.t_load
     )
-}
-
-fn build_superelement(spec_path: &Path) -> Result<(), Failure> {
-    let spec =
-        flexmb_superelement::Spec::read(spec_path).map_err(|e| Failure::Input(e.to_string()))?;
-    let base = spec_path.parent().unwrap_or(Path::new("."));
-    // errors in the input files (unreadable, truncated, mismatched K and M,
-    // a model that cannot be reduced) are input errors, exit code 2; a
-    // failed solver or write is exit code 1
-    let out = flexmb_superelement::build_from_spec(&spec, base).map_err(|e| {
-        if e.is_input() {
-            Failure::Input(e.to_string())
-        } else {
-            Failure::Compute(e.to_string())
-        }
-    })?;
-    say!("{}", out.result.summary(&spec.name).trim_end());
-    for f in &out.written {
-        say!("wrote {}", f.display());
-    }
-    Ok(())
 }

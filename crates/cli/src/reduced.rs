@@ -123,7 +123,7 @@ pub(crate) fn sweep(a: &SweepArgs, model: &Path, values: &[f64]) -> Result<(), F
     write_frequency_sweep(&sw, &comments, &a.out)?;
     if let Some(d) = &a.vtk {
         crate::vtk_out::write_reduced_sweep(
-            crate::vtk_out::VtkOut::new(d, a.vtk_chords),
+            crate::vtk_out::VtkOut::new(d, a.vtk_style),
             &mut red,
             a.t_load,
             k,

@@ -7,33 +7,56 @@ use crate::Failure;
 use faer::Mat;
 use flexmb_dynamics::Dynamics;
 use flexmb_model::Mechanism;
-use flexmb_vtk::{Drawing, Superelements};
+use flexmb_vtk::{Beams, Drawing, Superelements};
 use std::path::Path;
 
-/// Where `--vtk` writes and how it draws superelements (`--vtk-chords`).
+/// How `--vtk` draws superelements and beams (the options of every command
+/// that has `--vtk`).
+#[derive(clap::Args, Clone, Copy)]
+pub(crate) struct VtkStyle {
+    /// With --vtk: draw superelements as the chord between their nodes,
+    /// not as their FE mesh (smaller files for large meshes).
+    #[arg(long, requires = "vtk")]
+    vtk_chords: bool,
+    /// With --vtk: draw beams as boxes of their section swept along their
+    /// centre line (hexahedra), not as lines (their section is cell data
+    /// either way).
+    #[arg(long, requires = "vtk")]
+    vtk_boxes: bool,
+}
+
+/// Where `--vtk` writes and how it draws superelements (`--vtk-chords`)
+/// and beams (`--vtk-boxes`).
 #[derive(Clone, Copy)]
 pub(crate) struct VtkOut<'a> {
     /// The directory.
     pub dir: &'a Path,
     /// Superelements as their FE mesh or as chords.
     pub style: Superelements,
+    /// Beams as lines or boxes.
+    pub beams: Beams,
 }
 
 impl<'a> VtkOut<'a> {
-    /// `--vtk DIR` with `--vtk-chords` if `chords`.
-    pub(crate) fn new(dir: &'a Path, chords: bool) -> Self {
+    /// `--vtk DIR` drawn as `style` says.
+    pub(crate) fn new(dir: &'a Path, style: VtkStyle) -> Self {
         Self {
             dir,
-            style: if chords {
+            style: if style.vtk_chords {
                 Superelements::Chord
             } else {
                 Superelements::Mesh
+            },
+            beams: if style.vtk_boxes {
+                Beams::Boxes
+            } else {
+                Beams::Lines
             },
         }
     }
 
     fn drawing<'m>(&self, mech: &'m Mechanism) -> Result<Drawing<'m>, Failure> {
-        Drawing::new(mech, self.style).map_err(vtk_err)
+        Drawing::with_beams(mech, self.style, self.beams).map_err(vtk_err)
     }
 }
 

@@ -62,6 +62,42 @@ fn static_and_simulate_write_a_pvd_series() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let pvd = std::fs::read_to_string(dir.join("vtk/static.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 1, "{pvd}");
+    // with --vtk-boxes the guidance's beams are hexahedra, 4 each, their
+    // section in the cell data (crates/vtk/tests/meshio.rs checks the
+    // geometry); without --vtk it is refused
+    let o = flexmb()
+        .arg("static")
+        .arg(fixture("straight_guidance_planar.ron"))
+        .arg("--out")
+        .arg(dir.join("st"))
+        .arg("--vtk")
+        .arg(dir.join("boxes"))
+        .arg("--vtk-boxes")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let vtu = std::fs::read_to_string(dir.join("boxes/static_0000.vtu")).unwrap();
+    let lines = std::fs::read_to_string(dir.join("vtk/static_0000.vtu")).unwrap();
+    for f in [&vtu, &lines] {
+        assert!(f.contains("Name=\"section_dimensions\""), "no section data");
+    }
+    let types = |f: &str| -> Vec<u8> {
+        let a = f.split("Name=\"types\"").nth(1).unwrap();
+        let a = &a[a.find('>').unwrap() + 1..a.find("</DataArray>").unwrap()];
+        a.split_whitespace().map(|t| t.parse().unwrap()).collect()
+    };
+    let beams = types(&lines).iter().filter(|&&t| t == 3).count();
+    assert!(beams > 0);
+    assert_eq!(types(&vtu).iter().filter(|&&t| t == 12).count(), 4 * beams);
+    let o = flexmb()
+        .arg("static")
+        .arg(fixture("straight_guidance_planar.ron"))
+        .arg("--out")
+        .arg(dir.join("st"))
+        .arg("--vtk-boxes")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "--vtk-boxes without --vtk");
     std::fs::remove_dir_all(&dir).ok();
 }
 

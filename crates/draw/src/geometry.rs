@@ -1,9 +1,40 @@
 //! What a picture shows of a mechanism in one configuration: its elements
 //! as segments and markers, in model coordinates and projected.
+//!
+//! [`Style::Outline`] draws a beam as a thin box: the outline of its
+//! section's box ([`flexmb_model::BeamSection`]) swept along its deformed
+//! centre line (the four edges along it and the section at each end), and
+//! a superelement whose file has its FE mesh as the outline of that mesh,
+//! recovered at the configuration (`flexmb_superelement::recovery`): the
+//! edges where its boundary faces meet at more than [`OUTLINE_ANGLE_DEG`]
+//! at the reference ([`flexmb_element::fe_faces::feature_edges`]): the
+//! part's outline, without internal edges or the grid lines of flat faces. [`Style::Lines`] draws beams as lines between their
+//! nodes and superelements as their chord.
 
 use crate::View;
+use flexmb_element::fe_faces::feature_edges;
 use flexmb_element::Slot;
 use flexmb_model::{Mechanism, XRole};
+use flexmb_superelement::recovery::MeshRecovery;
+
+/// How beams and superelements are drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Style {
+    /// Beams as thin boxes of their section along their centre line,
+    /// superelements as the outline of their FE mesh (their chord if their
+    /// file has no mesh).
+    #[default]
+    Outline,
+    /// Beams as lines between their nodes, superelements as their chord.
+    Lines,
+}
+
+/// Segments of a beam's centre line drawn by [`Style::Outline`].
+pub const BEAM_STATIONS: usize = 8;
+
+/// The angle (degrees) between two boundary faces of a superelement's mesh
+/// above which their common edge belongs to its outline.
+pub const OUTLINE_ANGLE_DEG: f64 = 30.0;
 
 /// What an item of a picture stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -14,6 +45,8 @@ pub enum ItemKind {
     Truss,
     /// A superelement's chord between its two interface nodes (dashed).
     SuperelementChord,
+    /// An edge of the outline of a superelement's FE mesh.
+    SuperelementOutline,
     /// A superelement's interface node (a marker).
     InterfaceNode,
     /// A hinge (a marker at its node).
@@ -47,6 +80,7 @@ impl ItemKind {
             ItemKind::Beam => "beams",
             ItemKind::Truss => "trusses",
             ItemKind::SuperelementChord => "superelements (chord)",
+            ItemKind::SuperelementOutline => "superelements",
             ItemKind::InterfaceNode => "interface nodes",
             ItemKind::Hinge => "hinges",
             ItemKind::PointMass => "point masses",
@@ -147,8 +181,62 @@ fn element_nodes(mech: &Mechanism, own: &[Option<usize>], k: usize) -> Vec<usize
     }
 }
 
-/// The items of `mech` in the configuration `x`, projected by `view`.
+/// The items of `mech` in the configuration `x`, projected by `view`,
+/// beams as lines and superelements as their chord ([`Style::Lines`]).
 pub fn geometry(mech: &Mechanism, x: &[f64], view: View) -> Geometry {
+    styled_geometry(mech, x, view, Style::Lines)
+}
+
+/// The polylines of a beam drawn as a thin box at `x`: the four edges
+/// along its centre line and its section at each end (closed); `None` for
+/// an element without a section.
+fn beam_box(mech: &Mechanism, k: usize, x: &[f64]) -> Option<Vec<Vec<[f64; 3]>>> {
+    let el = &mech.elements[k];
+    let section = el.section.as_ref()?;
+    let n = el.x_index.len();
+    let (mut gathered, mut local) = (vec![0.0; n], vec![0.0; n]);
+    el.measured_at(x, &mut gathered, &mut local);
+    let corners: Vec<[[f64; 3]; 4]> = section
+        .stations(&local, BEAM_STATIONS)
+        .iter()
+        .map(|s| section.corners(s))
+        .collect();
+    let mut out: Vec<Vec<[f64; 3]>> = (0..4)
+        .map(|c| corners.iter().map(|s| s[c]).collect())
+        .collect();
+    for end in [&corners[0], &corners[corners.len() - 1]] {
+        out.push(vec![end[0], end[1], end[2], end[3], end[0]]);
+    }
+    Some(out)
+}
+
+/// The outline edges of a superelement's FE mesh recovered at `x` (each a
+/// polyline through its midside node, if any); `None` without a mesh with
+/// cells, or where the mesh cannot be placed.
+fn superelement_outline(mech: &Mechanism, k: usize, x: &[f64]) -> Option<Vec<Vec<[f64; 3]>>> {
+    let el = &mech.elements[k];
+    let data = el.superelement.as_deref()?;
+    let mesh = data.fe_mesh.as_ref().filter(|m| !m.cells.is_empty())?;
+    let mut recovery = MeshRecovery::new(data).ok()?;
+    let n = el.x_index.len();
+    if recovery.n_coords() != n {
+        return None;
+    }
+    let (mut gathered, mut local) = (vec![0.0; n], vec![0.0; n]);
+    el.measured_at(x, &mut gathered, &mut local);
+    let mut at = vec![[0.0; 3]; mesh.nodes.len()];
+    recovery.positions(&local, &mut at).ok()?;
+    Some(
+        feature_edges(&mesh.cells, &mesh.nodes, OUTLINE_ANGLE_DEG.to_radians())
+            .iter()
+            .map(|e| e.iter().map(|&i| at[i]).collect())
+            .collect(),
+    )
+}
+
+/// The items of `mech` in the configuration `x`, projected by `view`,
+/// beams and superelements drawn as `style` says.
+pub fn styled_geometry(mech: &Mechanism, x: &[f64], view: View, style: Style) -> Geometry {
     let pos = node_positions(mech, x);
     let own = owners(mech);
     let mut items = vec![];
@@ -178,8 +266,21 @@ pub fn geometry(mech: &Mechanism, x: &[f64], view: View) -> Geometry {
             push(kind, &e.id, vec![pos[nodes[0]]]);
             continue;
         }
-        for w in nodes.windows(2) {
-            push(kind, &e.id, vec![pos[w[0]], pos[w[1]]]);
+        let outline = match (style, kind) {
+            (Style::Outline, ItemKind::Beam) => beam_box(mech, k, x).map(|l| (ItemKind::Beam, l)),
+            (Style::Outline, ItemKind::SuperelementChord) => {
+                superelement_outline(mech, k, x).map(|l| (ItemKind::SuperelementOutline, l))
+            }
+            _ => None,
+        };
+        if let Some((kind, lines)) = outline {
+            for l in lines {
+                push(kind, &e.id, l);
+            }
+        } else {
+            for w in nodes.windows(2) {
+                push(kind, &e.id, vec![pos[w[0]], pos[w[1]]]);
+            }
         }
         if kind == ItemKind::SuperelementChord {
             for n in [nodes[0], nodes[nodes.len() - 1]] {

@@ -1,9 +1,10 @@
 //! Pictures of flexible mechanisms (`flexmb draw`): a configuration's
-//! beams, trusses, hinges, masses, rigid bodies and superelements
-//! (interface nodes and dashed chord) projected orthographically along an
-//! axis or isometrically, with the reference configuration overlaid and
-//! mode shapes of the linearization drawn as deformed shapes at a chosen
-//! amplitude.
+//! beams (thin boxes of their section along their deformed centre line, or
+//! lines), trusses, hinges, masses, rigid bodies and superelements (the
+//! outline of their recovered FE mesh, or their dashed chord, with their
+//! interface nodes) projected orthographically along an axis or
+//! isometrically, with the reference configuration overlaid and mode shapes
+//! of the linearization drawn as deformed shapes at a chosen amplitude.
 //!
 //! The geometry is data ([`geometry`]: items in model and projected
 //! coordinates), so tests check positions without pixels; [`Picture::plot`]
@@ -19,7 +20,10 @@ mod mode;
 mod picture;
 mod view;
 
-pub use geometry::{geometry, node_positions, Geometry, Item, ItemKind};
+pub use geometry::{
+    geometry, node_positions, styled_geometry, Geometry, Item, ItemKind, Style, BEAM_STATIONS,
+    OUTLINE_ANGLE_DEG,
+};
 pub use mode::{check_mode, mode_shape, Configuration, ModeShape};
 pub use picture::{
     figure_format, phase_factors, picture, DrawOptions, Format, Layer, Picture, MODE_COLOR,

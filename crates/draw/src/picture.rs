@@ -2,7 +2,7 @@
 //! drawn configuration, the phases of a mode shape) turned into a
 //! [`flexmb_plot::Plot`] with equal axis scales, and written as SVG or PNG.
 
-use crate::geometry::{geometry, Geometry, ItemKind};
+use crate::geometry::{styled_geometry, Geometry, ItemKind, Style};
 use crate::mode::{mode_shape, Configuration, ModeShape};
 use crate::{DrawError, View};
 use flexmb_plot::{Marker, Plot, Series};
@@ -27,6 +27,9 @@ pub struct DrawOptions {
     /// The title [default: the mechanism's name]; a mode's number,
     /// frequency and amplitude follow it.
     pub title: Option<String>,
+    /// Beams as thin boxes and superelements as their FE outline (the
+    /// default), or as lines and chords.
+    pub style: Style,
 }
 
 /// One layer of a picture: a configuration's items, drawn in one colour
@@ -69,7 +72,9 @@ fn kind_style(k: ItemKind) -> ((u8, u8, u8), Marker) {
     match k {
         ItemKind::Beam => ((0x00, 0x72, 0xb2), Marker::Circle),
         ItemKind::Truss => ((0x00, 0x9e, 0x73), Marker::Circle),
-        ItemKind::SuperelementChord => ((0xd5, 0x5e, 0x00), Marker::Circle),
+        ItemKind::SuperelementChord | ItemKind::SuperelementOutline => {
+            ((0xd5, 0x5e, 0x00), Marker::Circle)
+        }
         ItemKind::InterfaceNode => ((0xd5, 0x5e, 0x00), Marker::Square),
         ItemKind::Hinge => ((0xcc, 0x79, 0xa7), Marker::Circle),
         ItemKind::PointMass => ((0x56, 0xb4, 0xe9), Marker::Square),
@@ -118,10 +123,10 @@ pub fn picture(at: &Configuration, opts: &DrawOptions) -> Result<Picture, DrawEr
             label: "reference configuration".into(),
             color: Some(REFERENCE_COLOR),
             markers: false,
-            geometry: geometry(mech, &mech.x0, view),
+            geometry: styled_geometry(mech, &mech.x0, view, opts.style),
         });
     }
-    let here = geometry(mech, &at.x, view);
+    let here = styled_geometry(mech, &at.x, view, opts.style);
     let Some(k) = opts.mode else {
         layers.push(Layer {
             label: String::new(),
@@ -164,7 +169,7 @@ pub fn picture(at: &Configuration, opts: &DrawOptions) -> Result<Picture, DrawEr
             label: format!("mode {k}, {:+.2} × amplitude", f),
             color: Some(fade(MODE_COLOR, fading)),
             markers: j == 0,
-            geometry: geometry(mech, &x, view),
+            geometry: styled_geometry(mech, &x, view, opts.style),
         });
     }
     let title = format!(
@@ -208,11 +213,12 @@ fn polyline_of(g: &Geometry, kind: ItemKind) -> (Vec<f64>, Vec<f64>) {
     (xs, ys)
 }
 
-const KINDS: [ItemKind; 9] = [
+const KINDS: [ItemKind; 10] = [
     ItemKind::Beam,
     ItemKind::Truss,
     ItemKind::Other,
     ItemKind::SuperelementChord,
+    ItemKind::SuperelementOutline,
     ItemKind::InterfaceNode,
     ItemKind::Hinge,
     ItemKind::PointMass,

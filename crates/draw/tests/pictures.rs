@@ -3,7 +3,7 @@
 
 use flexmb_draw::{
     geometry, mode_shape, node_positions, picture, Configuration, DrawOptions, ItemKind, Picture,
-    View,
+    Style, View,
 };
 use flexmb_kinematics::Kinematics;
 use flexmb_model::{Mechanism, Scene};
@@ -204,6 +204,8 @@ fn a_mode_shape_is_the_eigenvector_scaled_to_the_amplitude() {
                 mode: Some(k),
                 amplitude: Some(amplitude),
                 phases: Some(3),
+                // every drawn point a node (tests/outline.rs: the boxes)
+                style: Style::Lines,
                 ..Default::default()
             },
         )
@@ -263,12 +265,13 @@ fn the_default_amplitude_is_a_tenth_of_the_size_and_bad_options_are_refused() {
         &at,
         &DrawOptions {
             mode: Some(1),
+            style: Style::Lines,
             ..Default::default()
         },
     )
     .unwrap();
     let size = pic.layers[0].geometry.size();
-    // the box around the guidance: 0.2 × 0.2 m
+    // the box around the guidance's nodes: 0.2 × 0.2 m
     assert!((size - 0.2 * 2f64.sqrt()).abs() < 1e-12, "{size}");
     let (shape, scale) = pic.mode.as_ref().unwrap();
     let a = scale * shape.largest_nodal_displacement(&at.mechanism);

@@ -44,6 +44,7 @@
 mod beam_matrices;
 mod custom;
 mod element;
+pub mod fe_faces;
 mod inertia;
 mod initial_orientation;
 mod kernels;

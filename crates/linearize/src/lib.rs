@@ -40,8 +40,8 @@ mod sweep;
 
 pub use mac::{mac, mac_matrix, track_modes, Tracking};
 pub use modes::{
-    asymmetry, buckling_factors, damped_modes, generalized_symmetric, undamped_modes,
-    undamped_modes_until, DampedMode, Modes,
+    asymmetry, buckling_factors, damped_modes, damped_modes_of, generalized_symmetric,
+    undamped_modes, undamped_modes_until, DampedMode, Modes,
 };
 pub use sweep::{sweep, sweep_until, SweepOptions, SweepOutcome, SweepParameter, SweepPoint};
 

@@ -188,15 +188,33 @@ pub fn damped_modes(lin: &Linearization) -> Result<Vec<DampedMode>, LinearizeErr
 
 /// [`damped_modes`] without naming the culprit of a failure.
 fn state_space_modes(lin: &Linearization) -> Result<Vec<DampedMode>, LinearizeError> {
-    let n = lin.m.nrows();
+    damped_modes_of(&lin.m, &lin.damping_total(), &lin.stiffness_total())
+}
+
+/// [`damped_modes`] of the matrices of M δq̈ + D δq̇ + K δq = 0 (`damping`
+/// D + C, `stiffness` K + G + N): e.g. a reduced linearization (F.5), whose
+/// closed-loop poles thesis Table 7.2 gives.
+pub fn damped_modes_of(
+    mass: &Mat<f64>,
+    damping: &Mat<f64>,
+    stiffness: &Mat<f64>,
+) -> Result<Vec<DampedMode>, LinearizeError> {
+    let n = mass.nrows();
+    if damping.nrows() != n || stiffness.nrows() != n {
+        return Err(LinearizeError::Dimension(format!(
+            "mass of order {n}, damping {}, stiffness {}",
+            damping.nrows(),
+            stiffness.nrows()
+        )));
+    }
     if n == 0 {
         return Ok(vec![]);
     }
-    let llt = sym(&lin.m)
+    let llt = sym(mass)
         .llt(Side::Lower)
         .map_err(|_| LinearizeError::MassNotPositive { dofs: vec![] })?;
-    let mut mk = lin.stiffness_total();
-    let mut mc = lin.damping_total();
+    let mut mk = stiffness.clone();
+    let mut mc = damping.clone();
     llt.solve_in_place(mk.as_mut());
     llt.solve_in_place(mc.as_mut());
     let a = Mat::from_fn(2 * n, 2 * n, |i, j| {

@@ -226,6 +226,13 @@ pub fn sweep_until(
         };
         if guess.is_some() && !matches!(solved, Ok(_) | Err(DynamicsError::Interrupted)) {
             recent.clear();
+            // from the last equilibrium's own configuration: the failed
+            // attempt left the position solve where it failed, from which q
+            // can be solved onto a flipped branch
+            if let Some(x) = xs.last() {
+                let x: &Vec<f64> = x;
+                dy.kinematics_mut().set_guess(x);
+            }
             solved = dy.static_equilibrium(opts.t, &q, &so);
         }
         if i > 0

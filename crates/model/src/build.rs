@@ -42,6 +42,8 @@ struct Expanded {
     group: String,
     element: Element,
     attach: Vec<Attach>,
+    /// A beam's section, for drawing.
+    section: Option<crate::BeamSection>,
 }
 
 /// An element built in Rust code, for instance a user-defined element

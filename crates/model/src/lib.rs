@@ -31,6 +31,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod beam_shape;
 mod build;
 mod chart;
 pub mod constraints;
@@ -46,6 +47,7 @@ mod roles;
 mod scene;
 mod time_function;
 
+pub use beam_shape::{BeamSection, Station};
 pub use build::{BuildStage, CodeElement};
 pub use chart::{ChartSwitch, EulerChart, CHART_SWITCH_RATIO};
 pub use constraints::ConstraintDiagnosis;

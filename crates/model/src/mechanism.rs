@@ -62,6 +62,9 @@ pub struct MechElement {
     /// λq, η̄) with η̄ its p, q and normal mode groups in turn. `None` for
     /// the other elements.
     pub superelement: Option<Arc<LinearSuperelement>>,
+    /// A beam's cross-section and reference frame, for drawing it as a box
+    /// ([`crate::BeamSection`]); `None` for the other elements.
+    pub section: Option<crate::BeamSection>,
 }
 
 impl MechElement {
@@ -70,6 +73,29 @@ impl MechElement {
     pub fn gather(&self, global: &[f64], local: &mut [f64]) {
         for (l, i) in local.iter_mut().zip(&self.x_index) {
             *l = global[*i];
+        }
+    }
+
+    /// The element's coordinates at `x` (one entry per nodal coordinate) as
+    /// the element measures them, into `local` (the element's order, with
+    /// `gathered` as work space, both of the element's length): rotations
+    /// since the nodes' initial orientations (λ ∘ λ0*, φ − φ0), the Euler
+    /// parameters of its orientation slots normalized. What drawing a
+    /// superelement's mesh (`flexmb_superelement::recovery`) or a beam's
+    /// box ([`crate::BeamSection`]) takes.
+    pub fn measured_at(&self, x: &[f64], gathered: &mut [f64], local: &mut [f64]) {
+        self.gather(x, gathered);
+        self.element.measured_coordinates(gathered, local);
+        let mut at = 0;
+        for slot in self.element.slots() {
+            if matches!(slot, flexmb_element::Slot::Orientation) {
+                let lam = &mut local[at..at + 4];
+                let n = lam.iter().map(|v| v * v).sum::<f64>().sqrt();
+                if n > 0.0 {
+                    lam.iter_mut().for_each(|v| *v /= n);
+                }
+            }
+            at += slot.len();
         }
     }
 

@@ -26,7 +26,8 @@
 
 use crate::model::{FeModel, Sources};
 use crate::readers::{
-    check_not_cut_off, fname, model_from_parts, parse_f64, read, read_inp, solid_elements,
+    check_not_cut_off, fname, model_from_parts, node_sets, parse_f64, read, read_inp,
+    solid_elements,
 };
 use crate::readers::{parse_inp, InpMesh};
 use crate::symmetric::assemble_upper;
@@ -342,6 +343,7 @@ fn abaqus_from_mesh(
         mesh: deck.to_string(),
     };
     model.solid = Some(solid_elements(&model, &mesh, deck));
+    model.node_sets = node_sets(&model, &mesh);
     Ok((model, mesh))
 }
 

@@ -179,6 +179,10 @@ pub struct BuildReport {
     /// a translational DOF (and in reports written before it was added).
     #[serde(default)]
     pub material: Option<crate::wave_speed::InferredMaterial>,
+    /// Warnings of the build (e.g. an interface a little off normal to the
+    /// p → q axis under a warping mode).
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 /// The result of a build: the superelement data plus what tests and reports need.
@@ -276,6 +280,9 @@ impl BuildResult {
             if let Some(a) = m.advice() {
                 out.push_str(&format!("warning: {a}\n"));
             }
+        }
+        for w in &r.warnings {
+            out.push_str(&format!("warning: {w}\n"));
         }
         let t: Vec<String> = r
             .timings
@@ -1084,6 +1091,14 @@ pub fn build(model: &FeModel, s: &BuildSettings) -> Result<BuildResult, Error> {
     crate::consistency::check_model(model)?;
     let ctx = Ctx::new(model, s)?;
     let fe_mass = ctx.checks(s)?;
+    let mut warnings = Vec::new();
+    let axis = sub(s.q, s.p);
+    for (side, want) in [s.warping_p, s.warping_q].into_iter().enumerate() {
+        if want {
+            let g = crate::interface::interface_geometry(model, &ctx.iface[side]);
+            warnings.extend(crate::interface::check_warping_plane(SIDE[side], &g, axis)?);
+        }
+    }
     timings.push(("checks".to_string(), t0.elapsed().as_secs_f64()));
 
     // main problem: both interfaces prescribed
@@ -1212,6 +1227,7 @@ pub fn build(model: &FeModel, s: &BuildSettings) -> Result<BuildResult, Error> {
         fe_mass,
         timings,
         material: crate::wave_speed::infer_material(model),
+        warnings,
     };
     Ok(BuildResult {
         data,

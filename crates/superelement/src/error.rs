@@ -105,6 +105,14 @@ pub enum Error {
     /// A numerical solver failed.
     #[error("solver: {0}")]
     Solver(String),
+    /// An external program (gmsh, CalculiX) is missing or failed.
+    #[error("{program}: {msg}")]
+    Tool {
+        /// The program.
+        program: String,
+        /// What happened, with its error lines.
+        msg: String,
+    },
     /// An invalid setting or specification.
     #[error("invalid specification: {0}")]
     Spec(String),

@@ -14,7 +14,7 @@
 use crate::solid::hex20_shape;
 
 /// A solid element type.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SolidKind {
     /// 4-node tetrahedron (C3D4).
     Tet4,
@@ -71,6 +71,60 @@ impl SolidKind {
             SolidKind::Hex20 => 25,
             SolidKind::Wedge6 => 13,
             SolidKind::Wedge15 => 26,
+        }
+    }
+}
+
+/// The edges of the midside nodes of the quadratic kinds in the
+/// Abaqus/CalculiX order: midside node `corners + k` lies on the edge
+/// between the corners `midside_edges()[k]`.
+const TET10_EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)];
+const HEX20_EDGES: [(usize, usize); 12] = [
+    (0, 1),
+    (1, 2),
+    (2, 3),
+    (3, 0),
+    (4, 5),
+    (5, 6),
+    (6, 7),
+    (7, 4),
+    (0, 4),
+    (1, 5),
+    (2, 6),
+    (3, 7),
+];
+const WEDGE15_EDGES: [(usize, usize); 9] = [
+    (0, 1),
+    (1, 2),
+    (2, 0),
+    (3, 4),
+    (4, 5),
+    (5, 3),
+    (0, 3),
+    (1, 4),
+    (2, 5),
+];
+
+impl SolidKind {
+    /// Every kind.
+    pub const ALL: [SolidKind; 6] = [
+        SolidKind::Tet4,
+        SolidKind::Tet10,
+        SolidKind::Hex8,
+        SolidKind::Hex20,
+        SolidKind::Wedge6,
+        SolidKind::Wedge15,
+    ];
+
+    /// The corner pairs of the midside nodes, in the Abaqus/CalculiX order
+    /// (empty for the linear kinds): node `n_nodes() − len + k` is the
+    /// middle of edge k.
+    pub fn midside_edges(self) -> &'static [(usize, usize)] {
+        match self {
+            SolidKind::Tet10 => &TET10_EDGES,
+            SolidKind::Hex20 => &HEX20_EDGES,
+            SolidKind::Wedge15 => &WEDGE15_EDGES,
+            _ => &[],
         }
     }
 }
@@ -325,7 +379,7 @@ impl std::ops::Mul<f64> for D {
 }
 
 /// Shape function values and natural derivatives at `p`.
-fn shape(kind: SolidKind, p: [f64; 3]) -> (Vec<f64>, Vec<[f64; 3]>) {
+pub(crate) fn shape(kind: SolidKind, p: [f64; 3]) -> (Vec<f64>, Vec<[f64; 3]>) {
     if kind == SolidKind::Hex20 {
         let (n, dn) = hex20_shape(p);
         return (n.to_vec(), dn.to_vec());
@@ -410,6 +464,91 @@ impl Integrator {
     }
 }
 
+/// Shape functions of a face (3- or 6-node triangle, 4- or 8-node
+/// quadrilateral, nodes in the order of `flexmb_element::fe_faces`: corners,
+/// then the midside nodes of the edges from corner i to i + 1) and their
+/// derivatives in the face's two natural coordinates (a dual number's first
+/// two components). The triangle is the unit triangle, the quadrilateral
+/// [−1, 1]².
+fn face_shape(n: usize, p: [f64; 2]) -> Option<Vec<D>> {
+    let (x, y) = (D::var(p[0], 0), D::var(p[1], 1));
+    let one = D::c(1.0);
+    Some(match n {
+        3 => vec![one - x - y, x, y],
+        6 => {
+            let l = [one - x - y, x, y];
+            let mut s: Vec<D> = l.iter().map(|&li| li * (2.0 * li - one)).collect();
+            for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+                s.push(4.0 * (l[a] * l[b]));
+            }
+            s
+        }
+        4 | 8 => {
+            let c = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+            let mut s: Vec<D> = c
+                .iter()
+                .map(|&[a, b]| 0.25 * ((one + a * x) * (one + b * y)))
+                .collect();
+            if n == 8 {
+                for (i, si) in s.iter_mut().enumerate() {
+                    let [a, b] = c[i];
+                    *si = *si * (a * x + b * y - one);
+                }
+                // midsides of the edges 0-1 (y = −1), 1-2 (x = 1), 2-3 (y = 1), 3-0 (x = −1)
+                s.push(0.5 * ((one - x * x) * (one - y)));
+                s.push(0.5 * ((one + x) * (one - y * y)));
+                s.push(0.5 * ((one - x * x) * (one + y)));
+                s.push(0.5 * ((one - x) * (one - y * y)));
+            }
+            s
+        }
+        _ => return None,
+    })
+}
+
+/// The area of a face with node positions `x` (3, 4, 6 or 8 nodes, in the
+/// order of `flexmb_element::fe_faces`) and its first moment ∫ x dA, over its isoparametric
+/// geometry (4 × 4 Gauss points, on the collapsed coordinates of the
+/// triangle: exact for flat faces with straight edges). `None` for another
+/// node count.
+pub fn face_moments(x: &[[f64; 3]]) -> Option<(f64, [f64; 3])> {
+    let tri = matches!(x.len(), 3 | 6);
+    let mut area = 0.0;
+    let mut first = [0.0; 3];
+    for &(u, wu) in &GAUSS4 {
+        for &(v, wv) in &GAUSS4 {
+            let (p, w) = if tri {
+                // ξ = a, η = (1 − a) b on [0, 1]²; Jacobian (1 − a)
+                let (a, b) = (0.5 * (1.0 + u), 0.5 * (1.0 + v));
+                ([a, (1.0 - a) * b], 0.25 * wu * wv * (1.0 - a))
+            } else {
+                ([u, v], wu * wv)
+            };
+            let s = face_shape(x.len(), p)?;
+            let mut pos = [0.0; 3];
+            let mut t = [[0.0; 3]; 2];
+            for (si, xi) in s.iter().zip(x) {
+                for r in 0..3 {
+                    pos[r] += si.v * xi[r];
+                    t[0][r] += si.g[0] * xi[r];
+                    t[1][r] += si.g[1] * xi[r];
+                }
+            }
+            let n = [
+                t[0][1] * t[1][2] - t[0][2] * t[1][1],
+                t[0][2] * t[1][0] - t[0][0] * t[1][2],
+                t[0][0] * t[1][1] - t[0][1] * t[1][0],
+            ];
+            let da = w * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            area += da;
+            for r in 0..3 {
+                first[r] += da * pos[r];
+            }
+        }
+    }
+    Some((area, first))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -470,20 +609,7 @@ mod tests {
         let x8: Vec<[f64; 3]> = (0..8).map(corner).collect();
         check("C3D8", element_moments(SolidKind::Hex8, &x8, c).unwrap());
         let mut x20 = x8.clone();
-        for (p, q) in [
-            (0, 1),
-            (1, 2),
-            (2, 3),
-            (3, 0),
-            (4, 5),
-            (5, 6),
-            (6, 7),
-            (7, 4),
-            (0, 4),
-            (1, 5),
-            (2, 6),
-            (3, 7),
-        ] {
+        for &(p, q) in SolidKind::Hex20.midside_edges() {
             x20.push(mid(corner(p), corner(q)));
         }
         check("C3D20", element_moments(SolidKind::Hex20, &x20, c).unwrap());
@@ -519,17 +645,7 @@ mod tests {
                 .collect();
             w6.add_scaled(&element_moments(SolidKind::Wedge6, &x, c).unwrap(), 1.0);
             let mut x15 = x.clone();
-            for (p, r) in [
-                (0, 1),
-                (1, 2),
-                (2, 0),
-                (3, 4),
-                (4, 5),
-                (5, 3),
-                (0, 3),
-                (1, 4),
-                (2, 5),
-            ] {
+            for &(p, r) in SolidKind::Wedge15.midside_edges() {
                 x15.push(mid(x[p], x[r]));
             }
             w15.add_scaled(&element_moments(SolidKind::Wedge15, &x15, c).unwrap(), 1.0);
@@ -542,14 +658,7 @@ mod tests {
     /// at every quadrature point.
     #[test]
     fn shape_functions_are_a_partition_of_unity() {
-        for kind in [
-            SolidKind::Tet4,
-            SolidKind::Tet10,
-            SolidKind::Hex8,
-            SolidKind::Hex20,
-            SolidKind::Wedge6,
-            SolidKind::Wedge15,
-        ] {
+        for kind in SolidKind::ALL {
             for (p, _) in rule(kind) {
                 let (n, dn) = shape(kind, p);
                 assert_eq!(n.len(), kind.n_nodes());
@@ -561,5 +670,74 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Faces integrate exactly where they are flat with straight edges: a
+    /// triangle and a quadrilateral (linear and quadratic, midside nodes at
+    /// the middle) have their polygon's area and centroid; a quadratic
+    /// quarter-circle edge gives the area of the curved face to the
+    /// quadrature error.
+    #[test]
+    fn faces_give_their_area_and_centroid() {
+        let mid =
+            |a: [f64; 3], b: [f64; 3]| -> [f64; 3] { std::array::from_fn(|d| 0.5 * (a[d] + b[d])) };
+        let t = [[0.0, 0.0, 1.0], [2.0, 0.0, 1.0], [0.0, 3.0, 1.0]];
+        let q = [
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 1.0, 1.0],
+            [0.0, 1.0, 1.0],
+        ];
+        let t6 = [
+            t[0],
+            t[1],
+            t[2],
+            mid(t[0], t[1]),
+            mid(t[1], t[2]),
+            mid(t[2], t[0]),
+        ];
+        let q8 = [
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            mid(q[0], q[1]),
+            mid(q[1], q[2]),
+            mid(q[2], q[3]),
+            mid(q[3], q[0]),
+        ];
+        for x in [&t[..], &t6[..]] {
+            let (a, f) = face_moments(x).unwrap();
+            assert!((a - 3.0).abs() < 1e-14, "{a}");
+            let c = [f[0] / a, f[1] / a, f[2] / a];
+            assert!(
+                (c[0] - 2.0 / 3.0).abs() < 1e-14
+                    && (c[1] - 1.0).abs() < 1e-14
+                    && (c[2] - 1.0).abs() < 1e-14
+            );
+        }
+        for x in [&q[..], &q8[..]] {
+            let (a, f) = face_moments(x).unwrap();
+            assert!((a - 2.0 * 2f64.sqrt()).abs() < 1e-14, "{a}");
+            assert!((f[0] / a - 1.0).abs() < 1e-14 && (f[1] / a - 0.5).abs() < 1e-14);
+        }
+        // a quarter disc of radius 1 as one 6-node triangle, its arc's
+        // midside node on the circle: the straight triangle (1/2) plus the
+        // parabolic segment over the chord, 2/3 × chord × the midside node's
+        // distance from the chord, √2 (s − 1/2) (planar: the area element
+        // is a polynomial, integrated exactly)
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        let disc = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.5, 0.0, 0.0],
+            [s, s, 0.0],
+            [0.0, 0.5, 0.0],
+        ];
+        let (a, _) = face_moments(&disc).unwrap();
+        let exact = 0.5 + 2.0 / 3.0 * 2f64.sqrt() * (2f64.sqrt() * (s - 0.5));
+        assert!((a - exact).abs() < 1e-14, "{a} against {exact}");
+        assert!(face_moments(&[[0.0; 3]; 5]).is_none());
     }
 }

@@ -26,7 +26,12 @@
 //!   the DOF mapping and nodal coordinates): the exports of the commercial
 //!   packages, with [`units`] for exports not in SI;
 //! * [`spec`]: a RON specification and [`build_from_spec`], the function behind
-//!   `flexmb build-superelement SPEC.ron`.
+//!   `flexmb build-superelement SPEC.ron`;
+//! * [`mesh_file`]: gmsh `.msh`/`.geo` and `.inp` meshes for the built-in FE
+//!   (now every solid kind, [`solid::SolidMesh`]) or a CalculiX run;
+//!   [`interface`]: where an interface lies (centroid, plane, the check of
+//!   warping modes); [`from_mesh`]: one command from a mesh to a
+//!   superelement (`flexmb build-superelement --mesh`).
 //!
 //! The sparse Cholesky factorization, the shift-invert eigensolver and the
 //! dense generalized eigensolver are those of `flexmb-linalg`
@@ -59,8 +64,11 @@ pub mod ansys;
 mod builder;
 pub mod consistency;
 mod error;
+pub mod from_mesh;
 pub mod geometry;
 pub mod harwell_boeing;
+pub mod interface;
+pub mod mesh_file;
 mod model;
 pub mod parts;
 pub mod readers;
@@ -79,5 +87,6 @@ pub use builder::{
     InterfacePattern, PointMass, RigidBodyProperties, RigidMotion, VE_INDEX,
 };
 pub use error::Error;
-pub use model::{DofMap, FeModel, NodeSelection, ReferenceMass, SolidElements, Sources};
-pub use spec::{build_from_spec, BuildOutput, ModelSource, Spec};
+pub use mesh_file::{MeshFile, MeshMaterial};
+pub use model::{DofMap, FeModel, NodeSelection, NodeSet, ReferenceMass, SolidElements, Sources};
+pub use spec::{build_from_spec, build_loaded, BuildOutput, FeSolver, ModelSource, Spec};

@@ -136,6 +136,22 @@ pub struct SolidElements {
     pub couplings: Vec<String>,
 }
 
+/// A named set of nodes of a model: a gmsh physical group (surface, curve,
+/// point) or an Abaqus/CalculiX *NSET, for interfaces by name
+/// ([`NodeSelection::Set`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NodeSet {
+    /// Its name (a gmsh physical group without a name is called by its
+    /// tag, e.g. "7").
+    pub name: String,
+    /// What it is, for messages: "physical surface", "node set", ….
+    pub what: String,
+    /// The gmsh physical tag, if it is a physical group.
+    pub tag: Option<i64>,
+    /// Node indices into the model, sorted.
+    pub nodes: Vec<usize>,
+}
+
 /// A mass the part must have (from a given volume and density).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReferenceMass {
@@ -165,6 +181,8 @@ pub struct FeModel {
     /// A mass the part must have, if known without elements (Matrix Market
     /// input with a volume and a density).
     pub reference_mass: Option<ReferenceMass>,
+    /// Named node sets (gmsh physical groups, *NSET of a deck).
+    pub node_sets: Vec<NodeSet>,
 }
 
 impl FeModel {
@@ -236,6 +254,7 @@ impl FeModel {
             sources: Sources::default(),
             solid: None,
             reference_mass: None,
+            node_sets: Vec::new(),
         })
     }
 
@@ -294,6 +313,49 @@ impl FeModel {
     /// The index of the node with label `id`.
     pub fn node_index(&self, id: u64) -> Option<usize> {
         self.index_of.get(&id).copied()
+    }
+    /// The node set called `name` (a gmsh physical group by name or by
+    /// tag, an *NSET; case-insensitive); an error listing the sets there are
+    /// when there is none of that name.
+    pub fn node_set(&self, name: &str) -> Result<&NodeSet, Error> {
+        // gmsh tags and names are per dimension: a surface first, as
+        // interfaces are surfaces
+        let surface_first = |s: &&NodeSet| !s.what.contains("surface");
+        let by_name = self
+            .node_sets
+            .iter()
+            .filter(|s| s.name == name)
+            .min_by_key(surface_first)
+            .or_else(|| {
+                self.node_sets
+                    .iter()
+                    .filter(|s| s.name.eq_ignore_ascii_case(name))
+                    .min_by_key(surface_first)
+            });
+        let by_tag = || {
+            let t: i64 = name.trim().parse().ok()?;
+            self.node_sets
+                .iter()
+                .filter(|s| s.tag == Some(t))
+                .min_by_key(surface_first)
+        };
+        by_name.or_else(by_tag).ok_or_else(|| {
+            let there = if self.node_sets.is_empty() {
+                "it has no named node sets (a gmsh mesh has them for its physical groups, a deck for its *NSET)"
+                    .to_string()
+            } else {
+                let names: Vec<String> = self.node_sets.iter().map(NodeSet::describe).collect();
+                let names_only: Vec<&str> = self.node_sets.iter().map(|s| s.name.as_str()).collect();
+                let hint = flexmb_input::nearest(name, names_only.iter())
+                    .map(|n| format!(" (did you mean '{n}'?)"))
+                    .unwrap_or_default();
+                format!("it has {}{hint}", names.join(", "))
+            };
+            Error::Selection(format!(
+                "model {} has no node set '{name}': {there}",
+                self.name
+            ))
+        })
     }
     /// The DOF map.
     pub fn dofs(&self) -> &DofMap {
@@ -533,10 +595,30 @@ pub enum NodeSelection {
         /// Radius (m).
         radius: f64,
     },
+    /// The nodes of a named node set of the model ([`FeModel::node_sets`]:
+    /// a gmsh physical surface, curve or point group by name or tag, an
+    /// *NSET of a deck; names compared without regard to case).
+    Set(String),
     /// Nodes in any of the selections.
     Union(Vec<NodeSelection>),
     /// Nodes in all of the selections.
     Intersection(Vec<NodeSelection>),
+}
+
+impl NodeSet {
+    /// "physical surface 'left' (tag 2, 25 nodes)".
+    pub fn describe(&self) -> String {
+        let tag = match self.tag {
+            Some(t) if t.to_string() != self.name => format!("tag {t}, "),
+            _ => String::new(),
+        };
+        format!(
+            "{} '{}' ({tag}{} nodes)",
+            self.what,
+            self.name,
+            self.nodes.len()
+        )
+    }
 }
 
 impl NodeSelection {
@@ -582,6 +664,7 @@ impl NodeSelection {
                     .filter(|&i| (dot(sub(c[i], *point), *normal) / nn).abs() <= *tolerance)
                     .collect()
             }
+            NodeSelection::Set(name) => model.node_set(name)?.nodes.clone(),
             NodeSelection::InBox { min, max } => all()
                 .filter(|&i| (0..3).all(|d| c[i][d] >= min[d] && c[i][d] <= max[d]))
                 .collect(),
@@ -642,4 +725,61 @@ pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::Triplet;
+
+    /// Named node sets: by name (then without regard to case), by tag, a
+    /// surface before a volume of the same name or tag (gmsh numbers each
+    /// dimension apart), and an unknown name listing the sets with the
+    /// nearest.
+    #[test]
+    fn node_sets_are_found_by_name_or_tag_surfaces_first() {
+        let eye: Vec<Triplet<usize, usize, f64>> =
+            (0..6).map(|i| Triplet::new(i, i, 1.0)).collect();
+        let a = SparseColMat::try_new_from_triplets(6, 6, &eye).unwrap();
+        let mut m = FeModel::new(
+            "part",
+            vec![1, 2],
+            vec![[0.0; 3], [1.0, 0.0, 0.0]],
+            DofMap::full(2),
+            a.as_ref(),
+            a.as_ref(),
+        )
+        .unwrap();
+        let set = |name: &str, what: &str, tag: Option<i64>, nodes: Vec<usize>| NodeSet {
+            name: name.into(),
+            what: what.into(),
+            tag,
+            nodes,
+        };
+        m.node_sets = vec![
+            set("7", "physical volume", Some(7), vec![0, 1]),
+            set("7", "physical surface", Some(7), vec![1]),
+            set("Left", "physical surface", Some(2), vec![0]),
+            set("END", "node set", None, vec![1]),
+        ];
+        assert_eq!(m.node_set("7").unwrap().what, "physical surface");
+        assert_eq!(m.node_set("left").unwrap().nodes, vec![0]);
+        assert_eq!(m.node_set("2").unwrap().name, "Left");
+        assert_eq!(m.node_set("end").unwrap().name, "END");
+        let e = m.node_set("lef").unwrap_err().to_string();
+        assert!(
+            e.contains("no node set 'lef'") && e.contains("did you mean 'Left'"),
+            "{e}"
+        );
+        assert!(
+            e.contains("physical surface 'Left' (tag 2, 1 nodes)"),
+            "{e}"
+        );
+        assert_eq!(
+            NodeSelection::Set("END".into())
+                .resolve(&m, "interface q")
+                .unwrap(),
+            vec![1]
+        );
+    }
 }

@@ -11,7 +11,7 @@
 //!   DOFs removed by *BOUNDARY / *EQUATION are absent from all three files.
 
 use crate::geometry::{Integrator, SolidKind};
-use crate::model::{DofMap, FeModel, SolidElements, Sources};
+use crate::model::{DofMap, FeModel, NodeSet, SolidElements, Sources};
 use crate::Error;
 use faer::sparse::{SparseColMat, SparseColMatRef};
 use std::collections::HashMap;
@@ -1185,7 +1185,31 @@ fn calculix_from_mesh(
         mesh: deck.clone(),
     };
     model.solid = Some(solid_elements(&model, &mesh, &deck));
+    model.node_sets = node_sets(&model, &mesh);
     Ok((model, mesh))
+}
+
+/// The *NSET of `mesh` over the nodes of `model` (labels the model does not
+/// have are passed over), sorted by name.
+pub(crate) fn node_sets(model: &FeModel, mesh: &InpMesh) -> Vec<NodeSet> {
+    let mut out: Vec<NodeSet> = mesh
+        .nsets
+        .iter()
+        .map(|(name, labels)| {
+            let mut nodes: Vec<usize> =
+                labels.iter().filter_map(|&l| model.node_index(l)).collect();
+            nodes.sort_unstable();
+            nodes.dedup();
+            NodeSet {
+                name: name.clone(),
+                what: "node set".to_string(),
+                tag: None,
+                nodes,
+            }
+        })
+        .collect();
+    out.sort_by(|a, b| a.name.cmp(&b.name));
+    out
 }
 
 /// The solid elements of `mesh` over the nodes of `model`, with the densities

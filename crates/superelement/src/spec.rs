@@ -21,6 +21,7 @@
 use crate::abaqus::read_abaqus;
 use crate::ansys::{read_ansys, AnsysFiles};
 use crate::builder::{build, BuildResult, BuildSettings};
+use crate::mesh_file::{run_calculix, MeshFile, MeshMaterial};
 use crate::model::{FeModel, ReferenceMass};
 use crate::readers::{
     read_calculix, read_matrix_market_model, write_file, write_matrix_market_dense,
@@ -35,6 +36,22 @@ use std::path::{Path, PathBuf};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum ModelSource {
+    /// A solid mesh with one material, its stiffness and mass computed by
+    /// the built-in FE or by CalculiX (module [`crate::mesh_file`]): a gmsh
+    /// `.msh` (ASCII 4.1 or 2.2), a gmsh `.geo` (meshed by `gmsh` with
+    /// second-order elements into `OUTPUT.msh`, next to the output), or an
+    /// Abaqus/CalculiX `.inp`. Its gmsh physical groups and *NSET are node
+    /// sets for [`crate::NodeSelection::Set`]. `units` scales the mesh's
+    /// coordinates only (the material is SI).
+    Mesh {
+        /// The mesh file.
+        file: String,
+        /// The material of every element (SI).
+        material: MeshMaterial,
+        /// The solver (default the built-in FE).
+        #[serde(default)]
+        solver: FeSolver,
+    },
     /// CalculiX exports `JOB.sti`, `JOB.mas`, `JOB.dof` and the mesh `inp`
     /// (default `JOB.inp`).
     CalculiX {
@@ -102,6 +119,18 @@ pub enum ModelSource {
         #[serde(default)]
         density: Option<f64>,
     },
+}
+
+/// The FE solver of a [`ModelSource::Mesh`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum FeSolver {
+    /// The built-in solid FE ([`crate::solid::SolidMesh::assemble`]; with
+    /// CalculiX's quadrature, so the two agree to rounding).
+    #[default]
+    Builtin,
+    /// CalculiX: a deck written and `ccx` run next to the output
+    /// ([`crate::mesh_file::run_calculix`]).
+    CalculiX,
 }
 
 /// A build specification.
@@ -189,11 +218,78 @@ pub fn si_factors(spec: &Spec) -> Result<(f64, f64, f64), Error> {
     ))
 }
 
+/// The path of the output without its extension (`DIR/part` for
+/// `DIR/part.se.ron`): work files of a [`ModelSource::Mesh`] are named after it.
+pub fn output_stem(spec: &Spec, base_dir: &Path) -> PathBuf {
+    let out = base_dir.join(&spec.output);
+    let name = out
+        .file_name()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let stem = name
+        .strip_suffix(".se.ron")
+        .or_else(|| name.strip_suffix(".ron"))
+        .unwrap_or(&name)
+        .to_string();
+    out.with_file_name(if stem.is_empty() { "part".into() } else { stem })
+}
+
 /// Loads the model a spec names, in SI (see [`si_factors`]).
 pub fn load_model(spec: &Spec, base_dir: &Path) -> Result<(FeModel, Vec<PathBuf>), Error> {
     let (l, k, m) = si_factors(spec)?;
     let rescale = |model: &mut FeModel| model.rescale(l, k, m);
     Ok(match &spec.model {
+        ModelSource::Mesh {
+            file,
+            material,
+            solver,
+        } => {
+            let path = base_dir.join(file);
+            let stem = output_stem(spec, base_dir);
+            let mut mesh = MeshFile::read(&path, &stem.with_extension("msh"))?;
+            let unit = match &spec.units {
+                Some(name) => UnitSystem::named(name)?,
+                None => UNIT_SYSTEMS[0],
+            };
+            for c in &mut mesh.coords {
+                for x in c.iter_mut() {
+                    *x *= unit.length;
+                }
+            }
+            let (mut model, mut files) = match solver {
+                FeSolver::Builtin => {
+                    let mut model = mesh.solid_mesh(material.material()?).assemble(
+                        &spec.name,
+                        &format!("the material's density {} kg/m³", material.rho),
+                    )?;
+                    model.node_sets = mesh.node_sets(&model);
+                    model.sources.mesh = file.clone();
+                    (model, Vec::new())
+                }
+                FeSolver::CalculiX => {
+                    let job_name = stem
+                        .file_name()
+                        .map(|s| s.to_string_lossy().to_string())
+                        .unwrap_or_default();
+                    let job = stem
+                        .with_file_name(format!("{job_name}_ccx"))
+                        .join(&job_name);
+                    let (mut model, files) =
+                        run_calculix(&mesh, material, &job, &format!("{} from {file}", spec.name))?;
+                    model.name = spec.name.clone();
+                    (model, files)
+                }
+            };
+            model.rescale(
+                1.0,
+                spec.stiffness_scale.unwrap_or(1.0),
+                spec.mass_scale.unwrap_or(1.0),
+            )?;
+            // the mesh file (and the .msh meshed from a .geo) first
+            let mut all = mesh.files.clone();
+            all.append(&mut files);
+            (model, all)
+        }
         ModelSource::CalculiX { job, inp, density } => {
             let job = base_dir.join(job);
             let inp = inp.as_ref().map(|p| base_dir.join(p));
@@ -327,9 +423,20 @@ pub fn read_ron(path: &Path) -> Result<LinearSuperelement, Error> {
 /// M̄ as Matrix Market if asked). Paths are relative to `base_dir`.
 pub fn build_from_spec(spec: &Spec, base_dir: &Path) -> Result<BuildOutput, Error> {
     let (model, files) = load_model(spec, base_dir)?;
-    let mut result = build(&model, &spec.settings)?;
+    build_loaded(spec, base_dir, &model, &files)
+}
+
+/// [`build_from_spec`] on a model already loaded by [`load_model`] from
+/// `files`.
+pub fn build_loaded(
+    spec: &Spec,
+    base_dir: &Path,
+    model: &FeModel,
+    files: &[PathBuf],
+) -> Result<BuildOutput, Error> {
+    let mut result = build(model, &spec.settings)?;
     let mut sources = Vec::new();
-    for f in &files {
+    for f in files {
         sources.push(source_entry(f)?);
     }
     sources.append(&mut result.data.provenance.sources);

@@ -208,6 +208,94 @@ fn the_abaqus_block_reads_and_its_mass_is_volume_times_density() {
     model.check_consistency().unwrap();
 }
 
+/// The built-in FE on the Abaqus block's own mesh (the deck read as a mesh
+/// by `ModelSource::Mesh`, E = 2e11 Pa, ν = 0.3, ρ = 2900 kg/m³ as in the
+/// deck) against the matrices Abaqus exported for it, an independent code:
+/// K equal to rounding (both integrate C3D10 at 4 points), so the
+/// superelements with constraint modes have the same S̄; Abaqus integrates
+/// the mass with more points, which moves M̄ but not the rigid-body mass,
+/// centre of mass and inertia (exact for straight-edged elements in both).
+#[test]
+fn the_builtin_fe_on_the_abaqus_block_mesh_gives_abaqus_stiffness() {
+    let a = dir().join("abaqus");
+    let (abaqus, _) = read_abaqus(
+        &a.join("blockC3D10.inp"),
+        &a.join("blockC3D10_STIF1.mtx"),
+        &a.join("blockC3D10_MASS1.mtx"),
+    )
+    .unwrap();
+    let spec = Spec::from_ron(
+        r#"(name: "block", model: Mesh(file: "abaqus/blockC3D10.inp", material: (e: 2e11, nu: 0.3, rho: 2900.0)),
+            settings: (p: (0.0, 0.5, 0.5), q: (4.0, 0.5, 0.5),
+                       interface_p: NearPlane(point: (0.0, 0.0, 0.0), normal: (1.0, 0.0, 0.0), tolerance: 1e-6),
+                       interface_q: NearPlane(point: (4.0, 0.0, 0.0), normal: (1.0, 0.0, 0.0), tolerance: 1e-6)),
+            output: "unused.se.ron")"#,
+        "block.spec.ron",
+    )
+    .unwrap();
+    let (own, files) = flexmb_superelement::spec::load_model(&spec, &dir()).unwrap();
+    assert_eq!(files, vec![a.join("blockC3D10.inp")]);
+    assert_eq!((own.n_nodes(), own.n_eq()), (257, 771));
+    // K entry by entry, nodes matched by label
+    let (ka, ko) = (dense(abaqus.k()), dense(own.k()));
+    let eq =
+        |m: &FeModel, label: u64, d: usize| m.dofs().eq(m.node_index(label).unwrap(), d).unwrap();
+    let (mut diff, mut scale) = (0.0f64, 0.0f64);
+    for &li in abaqus.node_ids() {
+        for &lj in abaqus.node_ids() {
+            for di in 0..3 {
+                for dj in 0..3 {
+                    let x = ka[(eq(&abaqus, li, di), eq(&abaqus, lj, dj))];
+                    let y = ko[(eq(&own, li, di), eq(&own, lj, dj))];
+                    diff = diff.max((x - y).abs());
+                    scale = scale.max(x.abs());
+                }
+            }
+        }
+    }
+    println!(
+        "K: largest difference {:.2e} of the largest entry",
+        diff / scale
+    );
+    assert!(
+        diff < 1e-13 * scale,
+        "K differs by {:e} of its largest entry",
+        diff / scale
+    );
+    let (x, y) = (
+        build(&abaqus, &spec.settings).unwrap(),
+        build(&own, &spec.settings).unwrap(),
+    );
+    let (sa, so) = (x.data.s_bar_matrix(), y.data.s_bar_matrix());
+    let w = (0..6)
+        .flat_map(|i| (0..6).map(move |j| (i, j)))
+        .map(|(i, j)| (sa[(i, j)] - so[(i, j)]).abs() / (sa[(i, i)] * sa[(j, j)]).sqrt())
+        .fold(0.0f64, f64::max);
+    println!("S̄: largest difference {w:.2e} (scaled by the diagonal)");
+    assert!(w < 1e-10, "S̄ differs by {w:e}");
+    let rb = |r: &flexmb_superelement::BuildResult| {
+        flexmb_superelement::RigidBodyProperties::from_m_bar(&r.data.m_bar_matrix(), r.data.l0)
+    };
+    let (ra, ro) = (rb(&x), rb(&y));
+    assert!(
+        (ra.mass / ro.mass - 1.0).abs() < 1e-12,
+        "{} {}",
+        ra.mass,
+        ro.mass
+    );
+    for d in 0..3 {
+        assert!(
+            (ra.com[d] - ro.com[d]).abs() < 1e-12,
+            "{:?} {:?}",
+            ra.com,
+            ro.com
+        );
+        for e in 0..3 {
+            assert!((ra.inertia[d][e] - ro.inertia[d][e]).abs() < 1e-9 * ra.inertia[0][0]);
+        }
+    }
+}
+
 #[test]
 fn files_that_do_not_belong_together_are_named() {
     let a = dir().join("abaqus");

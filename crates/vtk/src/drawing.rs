@@ -9,6 +9,32 @@ use flexmb_superelement::recovery::MeshRecovery;
 /// VTK cell types used besides those of the FE meshes.
 const VTK_VERTEX: u8 = 1;
 const VTK_LINE: u8 = 3;
+const VTK_HEXAHEDRON: u8 = 12;
+
+/// The hexahedra a beam element is drawn as with [`Beams::Boxes`], along
+/// its centre line ([`flexmb_model::BeamSection::stations`]).
+pub const BOX_SEGMENTS: usize = 4;
+
+/// How beams are drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Beams {
+    /// As the line between their two nodes (their section in the cell data).
+    #[default]
+    Lines,
+    /// As boxes of their section ([`flexmb_model::BeamSection::box_size`])
+    /// swept along their centre line, [`BOX_SEGMENTS`] hexahedra each.
+    Boxes,
+}
+
+/// A beam drawn as a box.
+struct BoxPart {
+    /// Its index in the mechanism's elements.
+    element: usize,
+    /// The index of its first corner point among the points.
+    offset: usize,
+    gathered: Vec<f64>,
+    local: Vec<f64>,
+}
 
 /// How superelements are drawn.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -40,15 +66,27 @@ struct MeshPart<'a> {
 pub struct Drawing<'a> {
     pub(crate) mech: &'a Mechanism,
     parts: Vec<MeshPart<'a>>,
+    boxes: Vec<BoxPart>,
     n_points: usize,
     /// Every point at the reference configuration x0.
     pub(crate) reference: Vec<[f64; 3]>,
 }
 
 impl<'a> Drawing<'a> {
-    /// `mech` drawn with its superelements as `style` says. An error when a
-    /// superelement's mesh cannot be placed at the reference configuration.
+    /// `mech` drawn with its superelements as `style` says and its beams as
+    /// lines. An error when a superelement's mesh cannot be placed at the
+    /// reference configuration.
     pub fn new(mech: &'a Mechanism, style: Superelements) -> Result<Self, VtkError> {
+        Self::with_beams(mech, style, Beams::Lines)
+    }
+
+    /// [`new`](Self::new) with the beams drawn as `beams` says. A box's
+    /// corners are points after the FE nodes of the meshes.
+    pub fn with_beams(
+        mech: &'a Mechanism,
+        style: Superelements,
+        beams: Beams,
+    ) -> Result<Self, VtkError> {
         let mut parts = Vec::new();
         let mut n_points = mech.nodes.len();
         if style == Superelements::Mesh {
@@ -81,14 +119,30 @@ impl<'a> Drawing<'a> {
                 n_points += mesh.nodes.len();
             }
         }
+        let mut boxes = Vec::new();
+        if beams == Beams::Boxes {
+            for (e, el) in mech.elements.iter().enumerate() {
+                if el.section.is_some() {
+                    boxes.push(BoxPart {
+                        element: e,
+                        offset: n_points,
+                        gathered: vec![0.0; el.x_index.len()],
+                        local: vec![0.0; el.x_index.len()],
+                    });
+                    n_points += 4 * (BOX_SEGMENTS + 1);
+                }
+            }
+        }
         let mut d = Self {
             mech,
             parts,
+            boxes,
             n_points,
             reference: Vec::new(),
         };
         let mut reference = vec![[0.0; 3]; n_points];
         d.place_meshes(&mech.x0, &mut reference)?;
+        d.place_boxes(&mech.x0, &mut reference);
         for (r, n) in reference.iter_mut().zip(&mech.nodes) {
             *r = std::array::from_fn(|k| n.at.get(k).copied().unwrap_or(0.0));
         }
@@ -121,7 +175,22 @@ impl<'a> Drawing<'a> {
             *o = std::array::from_fn(|d| n.position.get(d).map_or(0.0, |&i| x[i]));
         }
         self.place_meshes(x, &mut out)?;
+        self.place_boxes(x, &mut out);
         Ok(out)
+    }
+
+    /// The corners of every beam box at `x`, into `out` (all points).
+    fn place_boxes(&mut self, x: &[f64], out: &mut [[f64; 3]]) {
+        let mech = self.mech;
+        for b in &mut self.boxes {
+            let el = &mech.elements[b.element];
+            let section = el.section.as_ref().expect("a beam");
+            el.measured_at(x, &mut b.gathered, &mut b.local);
+            for (k, st) in section.stations(&b.local, BOX_SEGMENTS).iter().enumerate() {
+                let at = b.offset + 4 * k;
+                out[at..at + 4].copy_from_slice(&section.corners(st));
+            }
+        }
     }
 
     /// The point displacements of the increment `a` Δx at `x`: a Δx of the
@@ -167,15 +236,7 @@ impl<'a> Drawing<'a> {
         let mech = self.mech;
         for p in &mut self.parts {
             let el = &mech.elements[p.element];
-            el.gather(x, &mut p.gathered);
-            el.element.measured_coordinates(&p.gathered, &mut p.local);
-            for at in [3, 10] {
-                let lam = &mut p.local[at..at + 4];
-                let n = lam.iter().map(|v| v * v).sum::<f64>().sqrt();
-                if n > 0.0 {
-                    lam.iter_mut().for_each(|v| *v /= n);
-                }
-            }
+            el.measured_at(x, &mut p.gathered, &mut p.local);
             let n = p.recovery.mesh().nodes.len();
             p.recovery
                 .positions(&p.local, &mut out[p.offset..p.offset + n])
@@ -210,6 +271,15 @@ impl<'a> Drawing<'a> {
                         c.nodes.iter().map(|i| p.offset + i).collect(),
                         e,
                     ));
+                }
+                continue;
+            }
+            if let Some(b) = self.boxes.iter().find(|b| b.element == e) {
+                // corners 0–3 of a station wind about the beam's axis, so
+                // each hexahedron's base points into it (VTK's order)
+                for k in 0..BOX_SEGMENTS {
+                    let at = b.offset + 4 * k;
+                    out.push((VTK_HEXAHEDRON, (at..at + 8).collect(), e));
                 }
                 continue;
             }

@@ -18,12 +18,21 @@
 //!   its chord instead (smaller files); a superelement without a mesh is
 //!   always its chord. Beams, trusses and hinges are lines between their
 //!   two nodes (a hinge's nodes coincide), point masses and rigid bodies
-//!   vertices. Cell data: `element` (the index of the element in the
-//!   mechanism, the same on all cells of a mesh), `kind` (an integer: 1
-//!   beam, 2 truss, 3 hinge, 4 superelement, 5 point mass, 6 rigid body, 0
-//!   other: [`KINDS`]) and `axial_stiffness`, the first diagonal entry of
-//!   the element's stiffness times its reference length (EA of a beam or
-//!   truss, zero for kinds without an elongation).
+//!   vertices. With [`Beams::Boxes`] ([`Drawing::with_beams`]) a beam is
+//!   instead [`BOX_SEGMENTS`] hexahedra: the box of its section (a
+//!   rectangle's sides, a circle's or tube's outer diameter, √A for given
+//!   properties) swept along its centre line, the cubic through its nodes
+//!   tangent to their frames ([`flexmb_model::BeamSection`]), their corners
+//!   points after the FE nodes. Cell data: `element` (the index of the
+//!   element in the mechanism, the same on all cells of a mesh or box),
+//!   `kind` (an integer: 1 beam, 2 truss, 3 hinge, 4 superelement, 5 point
+//!   mass, 6 rigid body, 0 other: [`KINDS`]), `axial_stiffness`, the first
+//!   diagonal entry of the element's stiffness times its reference length
+//!   (EA of a beam or truss, zero for kinds without an elongation), and a
+//!   beam's section: `section_shape` (1 rectangle, 2 circle, 3 tube, 4
+//!   given properties, 0 not a beam: a truss has no section in a scene),
+//!   `section_dimensions` (rectangle by, bz, 0; circle d, d, 0; tube
+//!   d_outer, d_outer, d_inner; zeros otherwise) and `section_area` (m²).
 //! * Field data (values of the whole data set, e.g. a mode's frequency):
 //!   [`configuration_with_fields`].
 //! * A mode shape is an animated series over one period ([`mode_frames`],
@@ -38,13 +47,11 @@
 //! [`Drawing`] prepares a mechanism once (the mesh recoveries and the
 //! reference points) for the frames of a series; the free functions make
 //! one with the meshes drawn.
-//!
-//! Not yet: beams extruded to their section.
 
 mod drawing;
 mod xml;
 
-pub use drawing::{Drawing, Superelements};
+pub use drawing::{Beams, Drawing, Superelements, BOX_SEGMENTS};
 
 use flexmb_model::Mechanism;
 use std::fmt::Write as _;

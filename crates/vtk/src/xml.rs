@@ -143,6 +143,39 @@ pub(crate) fn unstructured_grid(
             format!("{ea:e}")
         }),
     );
+    let section = |e: usize| {
+        mech.elements[e]
+            .section
+            .as_ref()
+            .map(|b| (b.code_and_dimensions(), b.area()))
+    };
+    data_array(
+        &mut s,
+        "section_shape",
+        "Int32",
+        1,
+        cells
+            .iter()
+            .map(|(_, _, e)| section(*e).map_or(0, |((c, _), _)| c).to_string()),
+    );
+    data_array(
+        &mut s,
+        "section_dimensions",
+        "Float64",
+        3,
+        cells
+            .iter()
+            .map(|(_, _, e)| vector(&section(*e).map_or([0.0; 3], |((_, d), _)| d))),
+    );
+    data_array(
+        &mut s,
+        "section_area",
+        "Float64",
+        1,
+        cells
+            .iter()
+            .map(|(_, _, e)| format!("{:e}", section(*e).map_or(0.0, |(_, a)| a))),
+    );
     s.push_str("      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
     s
 }

@@ -32,6 +32,8 @@ pub struct PartBuild {
 
 /// The scene's file name.
 pub const SCENE_FILE: &str = "two_dof_mechanism.ron";
+/// The scene with chapter 7's actuator hinges.
+pub const ACTUATED_SCENE_FILE: &str = "two_dof_mechanism_actuated.ron";
 /// The skeleton with the releases (exactly constrained).
 pub const SKELETON_FILE: &str = "two_dof_skeleton.ron";
 /// The skeleton without the releases (nine times over-constrained).
@@ -102,6 +104,7 @@ pub fn write_model(dir: &Path, progress: &(dyn Fn(&str) + Sync)) -> Result<Vec<P
         std::fs::write(dir.join(name), text).map_err(|e| format!("{name}: {e}"))
     };
     write(SCENE_FILE, scene::full_scene(&layout))?;
+    write(ACTUATED_SCENE_FILE, scene::actuated_scene(&layout))?;
     write(
         SKELETON_FILE,
         scene::skeleton(&layout, scene::Releases::ALL),

@@ -377,7 +377,38 @@ enum Flexure {
 /// (chapter 4 leaves gravity out of the eigenvalue analyses): the text, to be
 /// written as `two_dof_mechanism.ron` next to the part files of [`DIR`].
 pub fn full_scene(layout: &Layout) -> String {
+    scene_text(layout, false)
+}
+
+/// The actuator hinges of thesis §7.2.1 and their ground nodes: (hinge,
+/// ground node, the base hinge whose B node is the arm's first node).
+pub const ACTUATORS: [(&str, &str, &str); 2] = [
+    ("act_x", "act_x.ground", "hb_x1"),
+    ("act_y", "act_y.ground", "hb_y"),
+];
+
+/// The full scene with the actuator hinges of chapter 7 (§7.2.1): between
+/// the fixed world and UpperArmX1, and between it and UpperArmY, axes along
+/// z, at the arms' base hinge axes, with zero stiffness and their bending
+/// deformations free, so that they neither stiffen nor constrain the arm;
+/// their rotations `act_x.rotation` and `act_y.rotation` are the
+/// co-located sensors φx, φy, and the PD controllers (7.12) act on them.
+pub fn actuated_scene(layout: &Layout) -> String {
+    scene_text(layout, true)
+}
+
+fn scene_text(layout: &Layout, actuated: bool) -> String {
     let mut st = SceneText::default();
+    if actuated {
+        for (hinge, ground, base) in ACTUATORS {
+            st.node(ground, layout.hinge(base).axis_point);
+            st.fix(format!(r#"Node("{ground}")"#));
+            st.element(format!(
+                r#"(id: "{hinge}", type: Hinge(nodes: ("{ground}", "{base}.B"), axis: Some({}), stiffness: 0.0, bending_stiffness: 0.0))"#,
+                v(Z)
+            ));
+        }
+    }
     hinge_sections(&mut st);
     for h in &layout.hinges {
         add_hinge(&mut st, h);
@@ -435,7 +466,11 @@ pub fn full_scene(layout: &Layout) -> String {
     st.rigid_beam("ee_link_x2", "EE.q", &node("hf_x2", true));
     st.rigid_beam("ee_link_y", END_EFFECTOR_NODE, &node("hf_y", true));
     st.finish(
-        "Two-DOF large-stroke compliant mechanism, a substitute of thesis ch. 4 (Fig. 4.6)",
+        if actuated {
+            "Two-DOF large-stroke compliant mechanism with the actuator hinges of thesis ch. 7 (§7.2.1)"
+        } else {
+            "Two-DOF large-stroke compliant mechanism, a substitute of thesis ch. 4 (Fig. 4.6)"
+        },
         &format!("    dofs: Deformations,\n    outputs: [Position(\"{END_EFFECTOR_NODE}\")],\n"),
     )
 }

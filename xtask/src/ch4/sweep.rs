@@ -22,7 +22,13 @@ pub const F_MAX: f64 = 200.0;
 /// `cargo xtask mechanism4`) with the end-effector's x and y as its first
 /// two degrees of freedom (the path coordinates), and their DOF indices.
 pub fn mechanism(scene: &Path) -> Result<(Arc<Mechanism>, [usize; 2]), String> {
-    let mut s = Scene::load(scene).map_err(|e| format!("{}: {e}", scene.display()))?;
+    let s = Scene::load(scene).map_err(|e| format!("{}: {e}", scene.display()))?;
+    mechanism_of(s, scene)
+}
+
+/// [`mechanism`] of a scene already read (and perhaps changed) from the file
+/// `scene` (whose directory holds the part files).
+pub fn mechanism_of(mut s: Scene, scene: &Path) -> Result<(Arc<Mechanism>, [usize; 2]), String> {
     for (k, c) in [Component::X, Component::Y].into_iter().enumerate() {
         s.dofs_first
             .insert(k, Select::Coord(END_EFFECTOR_NODE.into(), c));

@@ -178,6 +178,7 @@ pub(super) fn place(
         }
         elements.push(MechElement {
             superelement: part_data.remove(&e.id),
+            section: e.section,
             id: e.id,
             group: e.group,
             element: e.element,
@@ -198,6 +199,7 @@ pub(super) fn place(
                     x_index: o.clone(),
                     eps_offset,
                     superelement: None,
+                    section: None,
                 });
             }
         }

@@ -93,11 +93,23 @@ fn member_id(id: &str, n: usize, k: usize) -> String {
 
 impl Expander<'_> {
     fn push(&mut self, id: String, group: &str, element: Element, attach: Vec<Attach>) {
+        self.push_section(id, group, element, attach, None);
+    }
+
+    fn push_section(
+        &mut self,
+        id: String,
+        group: &str,
+        element: Element,
+        attach: Vec<Attach>,
+        section: Option<crate::BeamSection>,
+    ) {
         self.set.expanded.push(Expanded {
             id,
             group: group.to_string(),
             element,
             attach,
+            section,
         });
     }
 
@@ -210,9 +222,19 @@ impl Expander<'_> {
         let chain = chain_nodes(id, &b.nodes, &p, &q, b.n, &mut nodes.at, &mut nodes.order)?;
         for (k, (a, bb)) in chain.iter().enumerate() {
             let (pa, pb) = (&self.nodes.at[a], &self.nodes.at[bb]);
-            let element = match self.dim {
+            let (element, frame) = match self.dim {
                 Dimension::Planar => {
-                    Element::planar_beam([pa[0], pa[1]], [pb[0], pb[1]], &mat, &shape, &opts)
+                    let (dx, dy) = (pb[0] - pa[0], pb[1] - pa[1]);
+                    let l = dx.hypot(dy);
+                    let (c, s) = if l > 0.0 {
+                        (dx / l, dy / l)
+                    } else {
+                        (1.0, 0.0)
+                    };
+                    let element =
+                        Element::planar_beam([pa[0], pa[1]], [pb[0], pb[1]], &mat, &shape, &opts)
+                            .map_err(element_error(id))?;
+                    (element, [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
                 }
                 Dimension::Spatial => {
                     let axis = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
@@ -220,7 +242,7 @@ impl Expander<'_> {
                         Some(u) => vec3(ctx, "up", u)?,
                         None => default_up(&axis),
                     };
-                    Element::beam(
+                    let element = Element::beam(
                         [pa[0], pa[1], pa[2]],
                         [pb[0], pb[1], pb[2]],
                         up,
@@ -228,9 +250,18 @@ impl Expander<'_> {
                         &shape,
                         &opts,
                     )
+                    .map_err(element_error(id))?;
+                    // the element checked the axis and up
+                    let frame =
+                        flexmb_element::frame_from_axis(&axis, &up).map_err(element_error(id))?;
+                    (element, frame)
                 }
-            }
-            .map_err(element_error(id))?;
+            };
+            let section = crate::BeamSection {
+                shape,
+                frame,
+                planar: self.dim == Dimension::Planar,
+            };
             let mut attach = vec![
                 Attach::Pos(a.clone()),
                 Attach::Orient(a.clone()),
@@ -241,7 +272,7 @@ impl Expander<'_> {
                 attach.push(Attach::Group(warp_groups[k].clone()));
                 attach.push(Attach::Group(warp_groups[k + 1].clone()));
             }
-            self.push(member_id(id, b.n, k), id, element, attach);
+            self.push_section(member_id(id, b.n, k), id, element, attach, Some(section));
         }
         Ok(())
     }

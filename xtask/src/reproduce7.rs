@@ -1,0 +1,513 @@
+//! `cargo xtask reproduce ch7`: writes `results/ch7/` for thesis chapter 7
+//! ([`crate::ch7`]): IBM-c and IBM-u of the two-DOF mechanism along the
+//! path from 100 reference configurations, their eigenfrequencies against
+//! the unreduced model's (Figs 7.2, 7.3), the closed-loop poles (Table 7.2),
+//! the closed-loop response of IBM-u to the skew-sine moves with gravity
+//! from the undeflected configuration and from the gravity equilibrium
+//! (Figs 7.4–7.7), the unreduced closed loop for comparison, evaluations and
+//! wall times against the thesis's.
+
+use crate::ch4::path::Path4;
+use crate::ch4::sweep;
+use crate::ch7::{self, Variant};
+use crate::progress::Progress;
+use crate::report::{pct, sig, Figures, Table};
+use flexmb_dynamics::{Control, Dynamics, Integrator, SimulationOptions};
+use flexmb_linearize::SweepPoint;
+use flexmb_plot::{Plot, Series};
+use flexmb_reduction::{InterpolatedBasis, MechanicalModel};
+use std::fmt::Write;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Options of the reproduction.
+#[derive(Clone, Debug)]
+pub struct Ch7Options {
+    /// Reference configurations (the thesis: 100).
+    pub n_reference: usize,
+    /// Wall-time budget of the unreduced closed loop (s): it is stopped
+    /// there and reported as far as it got.
+    pub unreduced_budget: f64,
+}
+
+impl Default for Ch7Options {
+    fn default() -> Self {
+        Self {
+            n_reference: ch7::N_REFERENCE,
+            unreduced_budget: 240.0,
+        }
+    }
+}
+
+/// The thesis's evaluations of the IBM-u closed loop (§7.2.3).
+pub const THESIS_EVALUATIONS: usize = 8259;
+
+fn io(e: std::io::Error) -> String {
+    e.to_string()
+}
+
+/// One closed-loop run: its times, end-effector positions, evaluations,
+/// wall time, and how far it got.
+pub struct Run {
+    /// What it is.
+    pub label: String,
+    /// Output times.
+    pub t: Vec<f64>,
+    /// End-effector (x, y, z) at them.
+    pub ee: Vec<[f64; 3]>,
+    /// Right-hand-side (or residual) evaluations.
+    pub evaluations: usize,
+    /// Wall time (s).
+    pub seconds: f64,
+    /// Stopped by the budget before the end.
+    pub stopped: bool,
+}
+
+fn run_of(label: &str, mech: &flexmb_model::Mechanism, tr: &flexmb_dynamics::Trajectory) -> Run {
+    Run {
+        label: label.into(),
+        t: tr.t.clone(),
+        ee: tr.x.iter().map(|x| ch7::end_effector(mech, x)).collect(),
+        evaluations: tr.stats.rhs_evals,
+        seconds: tr.wall_time,
+        stopped: tr.stopped,
+    }
+}
+
+/// Everything the report shows.
+pub struct Ch7Results {
+    /// The reference configurations.
+    pub points: Vec<SweepPoint>,
+    /// Wall time of their sweep (s).
+    pub sweep_seconds: f64,
+    /// Per variant: wall time of the basis (s) and the reduced eigenfrequencies
+    /// at the reference configurations.
+    pub reduced: Vec<(Variant, f64, Vec<Vec<f64>>)>,
+    /// Closed-loop poles at s = 0: reduced IBM-u, and unreduced.
+    pub poles: [Vec<flexmb_linearize::DampedMode>; 2],
+    /// The closed-loop runs: IBM-u from the undeflected configuration and
+    /// from the gravity equilibrium, and the unreduced model.
+    pub runs: Vec<Run>,
+    /// The reference end-effector path (x, y, z) at the output times (IBM-u
+    /// with η ≡ 0, no gravity).
+    pub reference: Vec<[f64; 3]>,
+    /// The angle references at the output times.
+    pub angles: Vec<[f64; 2]>,
+    /// s(t) at the output times.
+    pub s_of_t: Vec<f64>,
+}
+
+/// The closed-loop poles of a linearization's matrices.
+fn poles(
+    m: &faer::Mat<f64>,
+    d: &faer::Mat<f64>,
+    k: &faer::Mat<f64>,
+) -> Result<Vec<flexmb_linearize::DampedMode>, String> {
+    flexmb_linearize::damped_modes_of(m, d, k).map_err(|e| e.to_string())
+}
+
+/// Runs chapter 7 (`o`), with progress on `pg`.
+pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results, String> {
+    // 1. the reference configurations (no gravity, no controllers)
+    let (mech, dofs) = ch7::mechanism(root, false, None)?;
+    let values = ch7::reference_values(o.n_reference);
+    let bar = pg.bar(
+        "ch7 reference configurations along the path",
+        2 * values.len() as u64,
+    );
+    let t = Instant::now();
+    let points = sweep::run(&mech, dofs, &values, ch7::R, &|d, _| bar.set(d as u64))?;
+    let sweep_seconds = t.elapsed().as_secs_f64();
+    bar.finish();
+    // 2. the bases and their eigenfrequencies at the reference configurations
+    let mut reduced = vec![];
+    let mut bases: Vec<(Variant, InterpolatedBasis)> = vec![];
+    for v in [Variant::Unconstrained, Variant::Constrained] {
+        let t = Instant::now();
+        let b = ch7::basis(&mech, dofs, &points, v)?;
+        let basis_seconds = t.elapsed().as_secs_f64();
+        pg.println(&format!("{} basis in {basis_seconds:.1} s", v.label()));
+        let f = ch7::reduced_frequencies(&mech, &b, &values, ch7::R)?;
+        reduced.push((v, basis_seconds, f));
+        bases.push((v, b));
+    }
+    let ibm_u = &bases[0].1;
+    // 3. the angle references from IBM-u's kinematics with η ≡ 0
+    let mut kin_model = ch7::reduced(&mech, ibm_u)?;
+    let refs = ch7::angle_references(&mut kin_model, 4 * o.n_reference)?;
+    // 4. closed-loop poles at s = 0, without gravity
+    let (lmech, _) = ch7::mechanism(root, false, Some(&refs))?;
+    let mut lm = ch7::reduced(&lmech, ibm_u)?;
+    let z0 = vec![0.0; lm.n_z()];
+    let lin = lm
+        .linearize(0.0, &z0, &z0, &z0)
+        .map_err(|e| e.to_string())?;
+    let reduced_poles = poles(&lin.m, &lin.damping, &lin.stiffness)?;
+    let mut dy = Dynamics::new(lmech.clone());
+    let q0 = lmech.q0();
+    let n = q0.len();
+    let full = dy
+        .linearize(0.0, &q0, &vec![0.0; n], &vec![0.0; n])
+        .map_err(|e| e.to_string())?;
+    let unreduced_poles = poles(&full.m, &full.damping_total(), &full.stiffness_total())?;
+    // 5. the closed loop with gravity
+    let (cmech, _) = ch7::mechanism(root, true, Some(&refs))?;
+    let times =
+        SimulationOptions::new(Integrator::Adams, 0.0, ch7::T_END, ch7::OUTPUTS).output_times;
+    let motion = ch7::reference_motion();
+    let s_of_t: Vec<f64> = times.iter().map(|t| motion.value(*t)).collect();
+    let angles: Vec<[f64; 2]> = times
+        .iter()
+        .map(|t| [refs[0].value(*t), refs[1].value(*t)])
+        .collect();
+    let reference = s_of_t
+        .iter()
+        .map(|s| {
+            let mut z = vec![0.0; kin_model.n_z()];
+            z[0] = *s;
+            let q = kin_model.full_coordinates(&z);
+            let dy = kin_model.dynamics_mut();
+            dy.kinematics_mut()
+                .solve(&q, 0.0)
+                .map_err(|e| e.to_string())?;
+            Ok(ch7::end_effector(&mech, dy.kinematics().x()))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let mut runs = vec![];
+    let adams = |rtol: f64| {
+        let mut o = SimulationOptions::new(Integrator::Adams, 0.0, ch7::T_END, ch7::OUTPUTS);
+        o.rtol = rtol;
+        o.atol = rtol * 1e-3;
+        o
+    };
+    for (label, from_equilibrium) in [
+        ("IBM-u from the undeflected configuration", false),
+        ("IBM-u from the gravity equilibrium", true),
+    ] {
+        let mut model = ch7::reduced(&cmech, ibm_u)?;
+        let mut z = z0.clone();
+        if from_equilibrium {
+            let eq = MechanicalModel::static_equilibrium(
+                &mut model,
+                0.0,
+                &z,
+                &flexmb_dynamics::StaticOptions::default(),
+            )
+            .map_err(|e| format!("the gravity equilibrium of IBM-u: {e}"))?;
+            z = eq.coordinates;
+        }
+        let bar = pg.bar(label, 1000);
+        let tr =
+            MechanicalModel::simulate(&mut model, 0.0, &z, &z0, &adams(1e-3), &mut |t, _, _| {
+                bar.set((t / ch7::T_END * 1000.0) as u64);
+                Control::Continue
+            })
+            .map_err(|e| format!("{label}: {e}"))?;
+        bar.finish();
+        runs.push(run_of(label, &cmech, &tr.full));
+    }
+    // 6. the unreduced closed loop, generalized-α, within its budget
+    let stop = Arc::new(AtomicBool::new(false));
+    let timer = {
+        let stop = stop.clone();
+        let budget = o.unreduced_budget;
+        std::thread::spawn(move || {
+            let start = Instant::now();
+            while start.elapsed().as_secs_f64() < budget {
+                if stop.load(std::sync::atomic::Ordering::Relaxed) {
+                    return;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(100));
+            }
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        })
+    };
+    let mut dy = Dynamics::new(cmech.clone());
+    let mut opts =
+        SimulationOptions::new(Integrator::GeneralizedAlpha, 0.0, ch7::T_END, ch7::OUTPUTS);
+    opts.rtol = 1e-3;
+    opts.atol = 1e-6;
+    opts.stop = Some(stop.clone());
+    let bar = pg.bar("unreduced closed loop (generalized-α)", 1000);
+    let tr = dy
+        .simulate(0.0, &cmech.q0(), &vec![0.0; n], &opts, |t, _, _| {
+            bar.set((t / ch7::T_END * 1000.0) as u64);
+            Control::Continue
+        })
+        .map_err(|e| format!("the unreduced closed loop: {e}"))?;
+    bar.finish();
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    let _ = timer.join();
+    runs.push(run_of(
+        "unreduced (generalized-α) from the undeflected configuration",
+        &cmech,
+        &tr,
+    ));
+    Ok(Ch7Results {
+        points,
+        sweep_seconds,
+        reduced,
+        poles: [reduced_poles, unreduced_poles],
+        runs,
+        reference,
+        angles,
+        s_of_t,
+    })
+}
+
+/// Writes the report of chapter 7 into `out`.
+pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
+    let start = Instant::now();
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let o = Ch7Options::default();
+    let r = compute(root, &o, pg)?;
+    let mut figs = Figures::default();
+    figures(&r, out, &mut figs).map_err(io)?;
+    let md = report(&o, &r, &figs, start.elapsed().as_secs_f64());
+    std::fs::write(out.join("report.md"), md).map_err(io)
+}
+
+/// The largest relative difference of mode k between a reduced model and
+/// the unreduced one over the reference configurations.
+pub fn mode_error(r: &Ch7Results, v: usize, k: usize) -> f64 {
+    r.points
+        .iter()
+        .zip(&r.reduced[v].2)
+        .map(|(p, f)| ((f[k] - p.frequencies_hz[k]) / p.frequencies_hz[k]).abs())
+        .fold(0.0, f64::max)
+}
+
+fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()> {
+    let s: Vec<f64> = r.points.iter().map(|p| p.s).collect();
+    for (stem, title, modes) in [
+        ("fig7_2_omega1_2", "Fig. 7.2: ω1, ω2 along the path", 0..2),
+        (
+            "fig7_3_omega3_8",
+            "Fig. 7.3: ω3–ω8 along the path",
+            2..ch7::R,
+        ),
+    ] {
+        let mut p = Plot::new(title, "arc length s (m)", "eigenfrequency (Hz)");
+        for k in modes {
+            let u: Vec<f64> = r.points.iter().map(|p| p.frequencies_hz[k]).collect();
+            p.push(Series::line(&format!("ω{} unreduced", k + 1), &s, &u));
+            for (v, _, f) in &r.reduced {
+                let y: Vec<f64> = f.iter().map(|f| f[k]).collect();
+                p.push(Series::dashed(&format!("ω{} {}", k + 1, v.label()), &s, &y));
+            }
+        }
+        figs.save(&p, out, stem)?;
+    }
+    let t: Vec<f64> = r.runs[0].t.clone();
+    let mut p = Plot::new("Fig. 7.4: the reference motion", "t (s)", "s (m), φ (rad)");
+    p.push(Series::line("s(t)", &t, &r.s_of_t));
+    for (k, name) in ["φx ref", "φy ref"].iter().enumerate() {
+        let a: Vec<f64> = r.angles.iter().map(|a| a[k]).collect();
+        p.push(Series::line(name, &t, &a));
+    }
+    figs.save(&p, out, "fig7_4_reference")?;
+    let mut p =
+        Plot::new("Fig. 7.5a: the end-effector in the plane", "x (m)", "y (m)").equal_aspect();
+    let xy = |e: &[[f64; 3]]| -> (Vec<f64>, Vec<f64>) { e.iter().map(|p| (p[0], p[1])).unzip() };
+    let (x, y) = xy(&r.reference);
+    p.push(Series::line("reference", &x, &y));
+    for run in &r.runs[..2] {
+        let (x, y) = xy(&run.ee);
+        p.push(Series::dashed(&run.label, &x, &y));
+    }
+    figs.save(&p, out, "fig7_5a_path")?;
+    let mut p = Plot::new(
+        "Fig. 7.5b: tracking errors of IBM-u (from the gravity equilibrium)",
+        "t (s)",
+        "error (m)",
+    );
+    for (k, name) in ["x_ref − x", "y_ref − y"].iter().enumerate() {
+        let e: Vec<f64> = r
+            .reference
+            .iter()
+            .zip(&r.runs[1].ee)
+            .map(|(a, b)| a[k] - b[k])
+            .collect();
+        p.push(Series::line(name, &t, &e));
+    }
+    figs.save(&p, out, "fig7_5b_errors")?;
+    let mut p = Plot::new("Fig. 7.6: z of the end-effector", "t (s)", "z (m)");
+    for run in &r.runs {
+        let z: Vec<f64> = run.ee.iter().map(|p| p[2]).collect();
+        p.push(Series::line(&run.label, &run.t, &z));
+    }
+    figs.save(&p, out, "fig7_6_z")?;
+    let (f, a) = spectrum(r);
+    let mut p = Plot::new(
+        "Fig. 7.7: single-sided amplitude spectrum of z_eq − z_undef (IBM-u)",
+        "frequency (Hz)",
+        "amplitude (m)",
+    );
+    let keep: Vec<usize> = (1..f.len()).filter(|k| f[*k] <= 300.0).collect();
+    p.push(Series::line(
+        "|Z(f)|",
+        &keep.iter().map(|k| f[*k]).collect::<Vec<_>>(),
+        &keep.iter().map(|k| a[*k]).collect::<Vec<_>>(),
+    ));
+    figs.save(&p, out, "fig7_7_spectrum")?;
+    Ok(())
+}
+
+/// The spectrum of z_eq − z_undef over the 1000 steps of the IBM-u runs.
+pub fn spectrum(r: &Ch7Results) -> (Vec<f64>, Vec<f64>) {
+    let z: Vec<f64> = r.runs[1]
+        .ee
+        .iter()
+        .zip(&r.runs[0].ee)
+        .skip(1)
+        .map(|(a, b)| a[2] - b[2])
+        .collect();
+    ch7::amplitude_spectrum(&z, ch7::T_END / (ch7::OUTPUTS - 1) as f64)
+}
+
+/// The local maxima of the spectrum above `floor` × its largest, by height.
+pub fn peaks(f: &[f64], a: &[f64], floor: f64) -> Vec<(f64, f64)> {
+    let top = a.iter().skip(1).fold(0.0f64, |m, v| m.max(*v));
+    let mut p: Vec<(f64, f64)> = (2..a.len() - 1)
+        .filter(|k| a[*k] > a[k - 1] && a[*k] >= a[k + 1] && a[*k] > floor * top)
+        .map(|k| (f[k], a[k]))
+        .collect();
+    p.sort_by(|x, y| y.1.total_cmp(&x.1));
+    p
+}
+
+fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# Chapter 7: the interpolated models of the two-DOF mechanism in closed loop\n\n\
+         The chapter-4 substitute mechanism with the actuator hinges of §7.2.1 \
+         (`fixtures/scenes/two_dof_mechanism_actuated.ron`), reduced along the path (4.1) \
+         from {} reference configurations to z = (s, η), 8 DOF, with constrained (IBM-c) \
+         and unconstrained (IBM-u) eigenvectors and MSI. Run time {wall:.0} s. Choices \
+         where the thesis is silent: docs/reproduce.md, \"Chapter 7\".\n",
+        o.n_reference
+    );
+    let _ = writeln!(s, "## Reduction\n");
+    let mut t = Table::new(&["", "thesis", "ours"]);
+    let n_q = r.points[0].q.len();
+    t.row(vec!["unreduced DOFs".into(), "688".into(), n_q.to_string()]);
+    t.row(vec![
+        "reduced DOFs".into(),
+        "8".into(),
+        (1 + ch7::R - 1).to_string(),
+    ]);
+    t.row(vec![
+        "reference configurations (sweep time)".into(),
+        "100".into(),
+        format!("{} ({:.1} s)", r.points.len(), r.sweep_seconds),
+    ]);
+    for (v, secs, _) in &r.reduced {
+        t.row(vec![
+            format!("{} basis", v.label()),
+            "–".into(),
+            format!("{secs:.1} s"),
+        ]);
+    }
+    let _ = writeln!(s, "{}", t.render());
+    let _ = writeln!(s, "## Eigenfrequencies along the path (Figs 7.2, 7.3)\n\nThe reduced models' rest linearization (F.7) at z = (s, 0) against the unreduced one at the reference configurations (the end-effector held there, its holding force a dead load): the largest relative difference of each mode along the path.\n");
+    let mut t = Table::new(&["mode", "IBM-c", "IBM-u"]);
+    for k in 0..ch7::R {
+        t.row(vec![
+            format!("ω{}", k + 1),
+            pct(mode_error(r, 1, k)),
+            pct(mode_error(r, 0, k)),
+        ]);
+    }
+    let _ = writeln!(s, "{}", t.render());
+    s += &figs.markdown(|f| f.starts_with("fig7_2") || f.starts_with("fig7_3"));
+    let _ = writeln!(s, "## Closed-loop poles at s = 0 (Table 7.2)\n\nPD controllers (7.12) with Table 7.1's gains on the actuator hinges, no gravity, the state-space eigenvalues of the linearization:\n");
+    let mut t = Table::new(&[
+        "mode",
+        "thesis (Hz, ζ)",
+        "IBM-u (Hz, ζ)",
+        "unreduced (Hz, ζ)",
+    ]);
+    for k in 0..2 {
+        let f = |p: &[flexmb_linearize::DampedMode]| {
+            p.get(k).map_or("–".into(), |m| {
+                format!("{}, {:.3}", sig(m.frequency_hz), m.damping_ratio)
+            })
+        };
+        t.row(vec![
+            (k + 1).to_string(),
+            format!("{}, {:.2}", ch7::THESIS_POLES[k].0, ch7::THESIS_POLES[k].1),
+            f(&r.poles[0]),
+            f(&r.poles[1]),
+        ]);
+    }
+    let _ = writeln!(s, "{}", t.render());
+    let _ = writeln!(s, "## Closed-loop response (Figs 7.4–7.7)\n\nFive skew-sine moves (7.13), T = 0.25 s, stopping 0.05 s at the marks of the path, 1.5 s with gravity, 1000 equidistant output steps, Adams (rtol 1e-3, atol 1e-6) for IBM-u; the angle references φx, φy from IBM-u's kinematics with η ≡ 0.\n");
+    let mut t = Table::new(&[
+        "run",
+        "evaluations",
+        "thesis",
+        "wall time",
+        "thesis",
+        "reached t",
+    ]);
+    for run in &r.runs {
+        t.row(vec![
+            run.label.clone(),
+            run.evaluations.to_string(),
+            if run.label.starts_with("IBM-u") {
+                THESIS_EVALUATIONS.to_string()
+            } else {
+                "\"millions\"".into()
+            },
+            format!("{:.1} s", run.seconds),
+            if run.label.starts_with("IBM-u") {
+                "≈ 1.5 h".into()
+            } else {
+                "–".into()
+            },
+            format!(
+                "{:.3} s{}",
+                run.t.last().copied().unwrap_or(0.0),
+                if run.stopped { " (budget)" } else { "" }
+            ),
+        ]);
+    }
+    let _ = writeln!(s, "{}", t.render());
+    let err = |k: usize| {
+        r.reference
+            .iter()
+            .zip(&r.runs[1].ee)
+            .map(|(a, b)| (a[k] - b[k]).abs())
+            .fold(0.0, f64::max)
+    };
+    let _ = writeln!(
+        s,
+        "Largest tracking errors of IBM-u from the gravity equilibrium: x {} m, y {} m \
+         (no integral action: steady errors remain at the stops, as the thesis says).\n",
+        sig(err(0)),
+        sig(err(1))
+    );
+    let (f, a) = spectrum(r);
+    let pk: Vec<String> = peaks(&f, &a, 0.05)
+        .iter()
+        .take(6)
+        .map(|(f, a)| format!("{} Hz ({} m)", sig(*f), sig(*a)))
+        .collect();
+    let _ = writeln!(
+        s,
+        "Peaks of the spectrum of z_eq − z_undef: {} (the thesis: near 65 and 110 Hz, \
+         modes 3 and 4, nothing above 180 Hz).\n",
+        pk.join(", ")
+    );
+    s += &figs.markdown(|f| {
+        f.starts_with("fig7_4")
+            || f.starts_with("fig7_5")
+            || f.starts_with("fig7_6")
+            || f.starts_with("fig7_7")
+    });
+    let _ = Path4::new();
+    s
+}
