@@ -649,7 +649,7 @@ fn speed_table(
 ) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "## Speed against error\n");
-    let _ = writeln!(s, "Wall times on this machine with other builds running (the §3.5.1 sweeps ran three at a time, so each time is that of a shared core). For a sweep, \"work\" counts its equilibria (each a Newton solve by continuation) and eigen-analyses; for a time response, the right-hand-side (or residual) evaluations. Errors are the largest relative deviations from the CalculiX solid over the frequencies named, at the solid's points (§3.5.1: M = 0, ±0.1 … ±0.4 N m; §3.5.3: ϕ = 0, ±5 … ±30°).\n");
+    let _ = writeln!(s, "Wall times on this machine with other builds running (the §3.5.1 sweeps ran three at a time, so each time is that of a shared core). For a sweep, \"work\" counts its equilibria (each a Newton solve by continuation) and eigen-analyses; for a time response, the right-hand-side (or residual) evaluations. Errors are the largest relative deviations from the CalculiX solid over the frequencies named, at the solid's points (§3.5.1: M = 0, ±0.1 … ±0.4 N m; §3.5.3: ϕ = {}°).\n", m.solid.iter().map(|q| format!("{:+.0}", q.phi)).collect::<Vec<_>>().join(", "));
     let mut t = Table::new(&[
         "§",
         "model",
@@ -758,12 +758,14 @@ fn speed_table(
                     100.0 * dz,
                     dp
                 )
-            } else {
+            } else if name.starts_with("run (ii)") {
                 "(reference of the line below)".into()
+            } else {
+                "–".into()
             },
         ]);
     }
     let _ = writeln!(s, "{}", t.render());
-    let _ = writeln!(s, "The CalculiX solids cost minutes per point (fixtures/curves/solid/README.md: the flexure 1–11 min per moment on 20 × 20 × 2, the mechanism up to 17 min per ϕ); the superelement models give a whole sweep in seconds.\n");
+    let _ = writeln!(s, "The CalculiX solids cost minutes per point (fixtures/curves/solid/README.md: the flexure 1–11 min per moment on 20 × 20 × 2, the mechanism 1.4–18.5 min per ϕ without gravity and up to 46 min with it, on one shared core); the superelement models give a whole sweep in seconds.\n");
     s
 }

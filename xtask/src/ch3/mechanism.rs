@@ -317,21 +317,28 @@ pub fn at_rotations(
             solves += 1;
             Ok(p)
         };
-        // secant from the two solves nearest the target in ϕ
+        // secant from the solve nearest the target in ϕ and the next nearest
+        // of another load and ϕ (two solves at one load would divide 0 by 0)
         let mut near: Vec<(f64, f64)> = solved.iter().map(|s| (s.0, s.2)).collect();
         near.sort_by(|a, b| (a.1 - target).abs().total_cmp(&(b.1 - target).abs()));
-        let (mut a, mut b) = match near[..] {
-            [p, q, ..] if p.1 != q.1 => (p, q),
-            [p, ..] => {
+        let p = *near.first().ok_or("no equilibrium")?;
+        let (mut a, mut b) = match near.iter().find(|q| q.0 != p.0 && q.1 != p.1) {
+            Some(&q) => (q, p),
+            None => {
                 // about 50° per M_MAX-scaled unit of load: a first guess
                 let l = p.0 + (target - p.1) / 50.0;
                 (p, (l, solve(&mut m, &mut solved, l)?))
             }
-            [] => return Err("no equilibrium".into()),
         };
         for _ in 0..40 {
             if (b.1 - target).abs() < 1e-7 {
                 break;
+            }
+            if b.0 == a.0 || b.1 == a.1 {
+                return Err(format!(
+                    "ϕ = {target}°: the secant iteration stalled at load scale {} (ϕ = {}°)",
+                    b.0, b.1
+                ));
             }
             let l = b.0 + (target - b.1) * (b.0 - a.0) / (b.1 - a.1);
             let p = solve(&mut m, &mut solved, l)?;
