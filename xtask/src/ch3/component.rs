@@ -316,8 +316,9 @@ fn full_model_frequencies(
         .map_err(|e| format!("full FE model: {e}"))
 }
 
-/// [`full_model_frequencies`] of the part meshed at element size `h`
-/// (along x, across): the mesh-convergence check.
+/// The first `n` frequencies (Hz) of the full FE model (interface p
+/// clamped, q rigid with the mass at node 7) of the part meshed at element
+/// size `h` (along x, across): the mesh-convergence check.
 pub fn full_frequencies(g: &Geometry, h: [f64; 2], n: usize) -> Result<Vec<f64>, String> {
     let g = Geometry { h, ..g.clone() };
     let (mesh, settings) = part(&g)?;
