@@ -342,20 +342,13 @@ pub fn read_solid(root: &Path) -> Result<Vec<SolidPoint>, String> {
 /// Reads a solid of the flexure written by `research/ch3/flexure.py` (rows
 /// `case, M, phi_deg, mode, f_Hz`), sorted by M.
 pub fn read_solid_file(p: &Path) -> Result<Vec<SolidPoint>, String> {
-    use crate::solid6::read_solid_keyed;
-    let by_m = read_solid_keyed(p, "solid", &["M", "phi_deg"], 0)?;
-    let by_phi = read_solid_keyed(p, "solid", &["M", "phi_deg"], 1)?;
-    if by_m.points.len() != by_phi.points.len() {
-        return Err(format!(
-            "{}: the moments and rotations do not pair up",
-            p.display()
-        ));
-    }
-    let mut v: Vec<SolidPoint> = by_m
-        .points
+    let mut v: Vec<SolidPoint> = crate::solid6::read_solid_points(p, &["M", "phi_deg"])?
         .into_iter()
-        .zip(by_phi.points)
-        .map(|((m, freqs), (phi, _))| SolidPoint { m, phi, freqs })
+        .map(|(c, freqs)| SolidPoint {
+            m: c[0],
+            phi: c[1],
+            freqs,
+        })
         .collect();
     v.sort_by(|a, b| a.m.total_cmp(&b.m));
     Ok(v)

@@ -242,7 +242,7 @@ pub fn reference_motion() -> TimeFunction {
 /// equations of motion do not need to be time integrated"), q = Q(s(t)):
 /// the rotations at `samples` arc lengths, a cubic spline in s, and then,
 /// with s(t) of [`reference_motion`], C¹ cubic pieces in t every millisecond
-/// (value and rate exact at the breaks) as piecewise polynomials.
+/// (value and rate exact at the breaks) as [`TimeFunction::Hermite`].
 pub fn angle_references(
     model: &mut ReducedModel,
     samples: usize,
@@ -289,40 +289,11 @@ pub fn angle_references(
             out[k][1].push(work[1][k] * sd);
         }
     }
-    let last = |k: usize| out[k][0][pieces];
-    Ok(std::array::from_fn(|k| TimeFunction::PiecewisePolynomial {
-        breaks: breaks.clone(),
-        coeffs: (0..pieces)
-            .map(|i| {
-                hermite_monomials(
-                    breaks[i],
-                    breaks[i + 1],
-                    [out[k][0][i], out[k][1][i]],
-                    [out[k][0][i + 1], out[k][1][i + 1]],
-                )
-            })
-            .collect(),
-        after: last(k),
+    Ok(std::array::from_fn(|k| TimeFunction::Hermite {
+        t: breaks.clone(),
+        value: std::mem::take(&mut out[k][0]),
+        rate: std::mem::take(&mut out[k][1]),
     }))
-}
-
-/// The cubic on [t0, t1] with value and rate `a` at t0 and `b` at t1, as
-/// coefficients of 1, t, t², t³ in absolute time (the form of
-/// [`TimeFunction::PiecewisePolynomial`]).
-pub fn hermite_monomials(t0: f64, t1: f64, a: [f64; 2], b: [f64; 2]) -> Vec<f64> {
-    let h = t1 - t0;
-    // in τ = t − t0: p = c0 + c1 τ + c2 τ² + c3 τ³
-    let c0 = a[0];
-    let c1 = a[1];
-    let c2 = (3.0 * (b[0] - a[0]) / h - 2.0 * a[1] - b[1]) / h;
-    let c3 = (2.0 * (a[0] - b[0]) / h + a[1] + b[1]) / (h * h);
-    // expand (t − t0)^k
-    vec![
-        c0 - c1 * t0 + c2 * t0 * t0 - c3 * t0.powi(3),
-        c1 - 2.0 * c2 * t0 + 3.0 * c3 * t0 * t0,
-        c2 - 3.0 * c3 * t0,
-        c3,
-    ]
 }
 
 /// The end-effector node's (x, y, z) in nodal coordinates `x`.
@@ -356,16 +327,6 @@ pub fn amplitude_spectrum(y: &[f64], dt: f64) -> (Vec<f64>, Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn hermite_pieces_have_the_end_values_and_rates() {
-        let (t0, t1) = (1.2, 1.201);
-        let c = hermite_monomials(t0, t1, [0.3, -2.0], [0.298, -1.9]);
-        let p = |t: f64| c[0] + c[1] * t + c[2] * t * t + c[3] * t.powi(3);
-        let dp = |t: f64| c[1] + 2.0 * c[2] * t + 3.0 * c[3] * t * t;
-        assert!((p(t0) - 0.3).abs() < 1e-12 && (p(t1) - 0.298).abs() < 1e-12);
-        assert!((dp(t0) + 2.0).abs() < 1e-8 && (dp(t1) + 1.9).abs() < 1e-8);
-    }
 
     #[test]
     fn the_reference_motion_stops_at_the_marks() {

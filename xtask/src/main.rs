@@ -55,6 +55,14 @@ enum Cmd {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// The chapter-4 base cross-hinge against its stored CalculiX solid
+    /// (issue 17): report.md, hinge.csv, figures and the models' scenes in
+    /// OUT.
+    Hinge4 {
+        /// Output directory.
+        #[arg(long, default_value = "results/ch4_hinge")]
+        out: PathBuf,
+    },
     /// Recompute the eigenfrequency curves and compare them with fixtures/curves.
     Regress {
         /// Store the recomputed curves as the new fixtures instead of comparing.
@@ -117,6 +125,14 @@ fn main() -> ExitCode {
             reproduce(&root, &out, chapter, &pg)
         }
         Cmd::Mechanism4 { out } => mechanism4(out.unwrap_or_else(xtask::ch4::fixture_dir)),
+        Cmd::Hinge4 { out } => {
+            let out = if out.is_absolute() {
+                out
+            } else {
+                root.join(out)
+            };
+            xtask::ch4::hinge_check::write_report(&root, &out)
+        }
         Cmd::Regress { update, chapter } => {
             regress(&root, update, chapter.unwrap_or(Chapter::All), &pg)
         }

@@ -49,30 +49,86 @@ pub fn read_solid_keyed(
     columns: &[&str],
     key: usize,
 ) -> Result<SolidCurve, String> {
+    let points = read_solid_points(path, columns)?
+        .into_iter()
+        .map(|(c, f)| (c[key], f))
+        .collect();
+    Ok(SolidCurve {
+        label: label.into(),
+        points,
+    })
+}
+
+/// The numeric columns of a table written by a solid script: each row's
+/// last `columns.len()` comma-separated values (a case column before them
+/// may hold commas). Lines starting with `#` say how the file was made and
+/// are skipped, and so is the header, the first other line. An error names
+/// the file, the line and the columns expected.
+pub fn read_numeric_rows(path: &Path, columns: &[&str]) -> Result<Vec<Vec<f64>>, String> {
+    Ok(numbered_rows(path, columns)?
+        .into_iter()
+        .map(|(_, r)| r)
+        .collect())
+}
+
+/// [`read_numeric_rows`] with each row's line number (from 1).
+fn numbered_rows(path: &Path, columns: &[&str]) -> Result<Vec<(usize, Vec<f64>)>, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut points: Vec<(f64, Vec<f64>)> = vec![];
-    let width = columns.len() + 2;
-    for (i, line) in text.lines().enumerate().skip(1) {
+    let mut rows = vec![];
+    let lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim_start().starts_with('#'))
+        .skip(1);
+    for (i, line) in lines {
         let c: Vec<&str> = line.split(',').map(str::trim).collect();
         let bad = || {
             format!(
-                "{}:{}: expected `…, {}, mode, f_Hz`, found `{line}`",
+                "{}:{}: expected `…, {}`, found `{line}`",
                 path.display(),
                 i + 1,
                 columns.join(", ")
             )
         };
-        if c.len() < width {
+        if c.len() < columns.len() {
             return Err(bad());
         }
-        let num = |s: &str| s.parse::<f64>().map_err(|_| bad());
-        let (x, mode, f) = (
-            num(c[c.len() - width + key])?,
-            num(c[c.len() - 2])?,
-            num(c[c.len() - 1])?,
-        );
+        let row: Result<Vec<f64>, String> = c[c.len() - columns.len()..]
+            .iter()
+            .map(|s| s.parse::<f64>().map_err(|_| bad()))
+            .collect();
+        rows.push((i + 1, row?));
+    }
+    if rows.is_empty() {
+        return Err(format!("{}: no rows", path.display()));
+    }
+    Ok(rows)
+}
+
+/// One point of a solid curve: its key columns and its frequencies (Hz).
+pub type KeyedFrequencies = (Vec<f64>, Vec<f64>);
+
+/// The points of a solid curve whose rows end in `columns…, mode, f_Hz`:
+/// per point its `columns` and its frequencies f1 … fk, in the order of the
+/// file. Consecutive rows with the same `columns` are one point, their modes
+/// numbered 1, 2, … in order.
+pub fn read_solid_points(path: &Path, columns: &[&str]) -> Result<Vec<KeyedFrequencies>, String> {
+    let mut all: Vec<&str> = columns.to_vec();
+    all.extend(["mode", "f_Hz"]);
+    let rows = numbered_rows(path, &all)?;
+    let n = columns.len();
+    let mut points: Vec<KeyedFrequencies> = vec![];
+    for (line, r) in rows {
+        let (key, mode, f) = (&r[..n], r[n], r[n + 1]);
+        let bad = || {
+            format!(
+                "{}:{line}: mode {mode} out of order (modes 1, 2, … per point of `{}`)",
+                path.display(),
+                columns.join(", ")
+            )
+        };
         match points.last_mut() {
-            Some((px, fs)) if *px == x => {
+            Some((pk, fs)) if pk.as_slice() == key => {
                 if mode as usize != fs.len() + 1 {
                     return Err(bad());
                 }
@@ -82,17 +138,11 @@ pub fn read_solid_keyed(
                 if mode != 1.0 {
                     return Err(bad());
                 }
-                points.push((x, vec![f]))
+                points.push((key.to_vec(), vec![f]))
             }
         }
     }
-    if points.is_empty() {
-        return Err(format!("{}: no rows", path.display()));
-    }
-    Ok(SolidCurve {
-        label: label.into(),
-        points,
-    })
+    Ok(points)
 }
 
 /// A beam model of the comparison.
@@ -363,6 +413,28 @@ mod tests {
         assert_eq!(c.points.len(), 2);
         assert_eq!(c.points[0], (0.0, vec![5.3, 79.4]));
         assert_eq!(c.points[1], (0.02, vec![5.4]));
+    }
+
+    #[test]
+    fn comment_lines_are_skipped_and_rows_keep_their_columns() {
+        let p = write(
+            "comments.csv",
+            "# made by a script\n# with a mesh\ncase,M,phi_deg,mode,f_Hz\nsolid,a,0.5,10,1,5.0\nsolid,a,0.5,10,2,7.0\n# a note\nsolid,a,1,20,1,6.0\n",
+        );
+        let pts = read_solid_points(&p, &["M", "phi_deg"]).unwrap();
+        assert_eq!(
+            pts,
+            vec![
+                (vec![0.5, 10.0], vec![5.0, 7.0]),
+                (vec![1.0, 20.0], vec![6.0])
+            ]
+        );
+        let rows = read_numeric_rows(&p, &["phi_deg", "mode", "f_Hz"]).unwrap();
+        assert_eq!(rows.len(), 3);
+        assert_eq!(rows[2], vec![20.0, 1.0, 6.0]);
+        let e = read_numeric_rows(&write("bad_comment.csv", "# x\nh\ncase,1,x\n"), &["a", "b"])
+            .unwrap_err();
+        assert!(e.contains("bad_comment.csv:3:"), "{e}");
     }
 
     #[test]

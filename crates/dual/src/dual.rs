@@ -148,8 +148,11 @@ impl<T: Real, const N: usize> Div for Dual<T, N> {
     type Output = Self;
     #[inline]
     fn div(self, o: Self) -> Self {
+        // the value divided, not multiplied by the reciprocal: the value
+        // part is then exactly the f64 evaluation's (the position solve
+        // mixes plain and dual evaluations of the same deformations)
         let inv = T::one() / o.re;
-        let re = self.re * inv;
+        let re = self.re / o.re;
         let mut eps = [T::zero(); N];
         for (i, e) in eps.iter_mut().enumerate() {
             *e = (self.eps[i] - re * o.eps[i]) * inv;
@@ -216,8 +219,14 @@ impl<T: Real, const N: usize> Mul<f64> for Dual<T, N> {
 impl<T: Real, const N: usize> Div<f64> for Dual<T, N> {
     type Output = Self;
     #[inline]
-    fn div(self, o: f64) -> Self {
-        self * (1.0 / o)
+    fn div(mut self, o: f64) -> Self {
+        // the value exactly as an f64 division (see `Div for Dual`)
+        let inv = 1.0 / o;
+        self.re = self.re / o;
+        for e in self.eps.iter_mut() {
+            *e = *e * inv;
+        }
+        self
     }
 }
 

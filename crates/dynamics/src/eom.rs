@@ -45,7 +45,7 @@ const STOP_CHECK_ELEMENTS: usize = 16;
 /// consecutive elements with the same S are stacked (up to [`STACK_ROWS`]
 /// rows) and added to Mq by one product WᵀW when S changes; on a contiguous S
 /// directly into the diagonal block of Mq, else through a compact block.
-struct Assembly {
+pub(crate) struct Assembly {
     /// Column set of the stacked W (first `pending` entries valid).
     cols: Vec<usize>,
     pending: usize,
@@ -72,8 +72,9 @@ struct Assembly {
 const STACK_ROWS: usize = 96;
 
 impl Assembly {
-    fn new(mech: &flexmb_model::Mechanism) -> Self {
-        let n_q = mech.n_dof();
+    /// Work arrays for a product over `n_q` columns (the DOFs for Mq, the
+    /// reduced coordinates for a projected mass).
+    pub(crate) fn new(mech: &flexmb_model::Mechanism, n_q: usize) -> Self {
         let nmax = mech
             .elements
             .iter()
@@ -108,22 +109,26 @@ impl Assembly {
     }
 
     /// Adds F_eᵀ M_e F_e of element `ei` (local coordinates `xl`) to the
-    /// lower triangle of Mq (possibly at the next [`flush`](Self::flush)).
+    /// lower triangle of Mq (possibly at the next [`flush`](Self::flush)),
+    /// F the n_x × n_q transfer matrix (F,q, or F,z of a projection).
     fn add_element(
         &mut self,
         ei: usize,
         el: &Element,
         xl: &[f64],
-        fq: &Mat<f64>,
-        n_q: usize,
+        fq: MatRef<'_, f64>,
         mq: &mut Mat<f64>,
     ) {
-        let n = xl.len();
+        let (n, n_q) = (xl.len(), fq.ncols());
         // the non-zero columns of F_e, gathered
         let runs = &self.runs[ei];
         let mut s = 0;
         for c in 0..n_q {
-            let col = fq.col_as_slice(c);
+            let col = fq
+                .col(c)
+                .try_as_col_major()
+                .expect("F,q and F,z are stored by columns")
+                .as_slice();
             let dst = &mut self.fe.col_as_slice_mut(s)[..n];
             for &(g, k, len) in runs {
                 dst[k..k + len].copy_from_slice(&col[g..g + len]);
@@ -166,7 +171,7 @@ impl Assembly {
         let r = MatRef::from_row_major_slice(&self.re[..m * n], m, n);
         let fe = self.fe.as_ref().submatrix(0, 0, n, s);
         let w = self.w.as_mut().submatrix_mut(self.rows, 0, m, s);
-        matmul(w, Accum::Replace, r, fe, 1.0, Par::Seq);
+        product(w, r, fe);
         self.rows += m;
     }
 
@@ -183,33 +188,91 @@ impl Assembly {
         if self.cols[s - 1] - c0 + 1 == s {
             // contiguous columns: straight into the diagonal block
             let dst = mq.as_mut().submatrix_mut(c0, c0, s, s);
-            tri_matmul(
-                dst,
-                BlockStructure::TriangularLower,
-                Accum::Add,
-                w.transpose(),
-                BlockStructure::Rectangular,
-                w,
-                BlockStructure::Rectangular,
-                1.0,
-                Par::Seq,
-            );
+            gram_lower(dst, w, Accum::Add);
         } else {
             let mut c = self.c.as_mut().submatrix_mut(0, 0, s, s);
-            tri_matmul(
-                c.as_mut(),
-                BlockStructure::TriangularLower,
-                Accum::Replace,
-                w.transpose(),
-                BlockStructure::Rectangular,
-                w,
-                BlockStructure::Rectangular,
-                1.0,
-                Par::Seq,
-            );
+            gram_lower(c.as_mut(), w, Accum::Replace);
             add_lower(mq, c.as_ref(), &self.cols[..s]);
         }
     }
+}
+
+/// Column counts up to which the element-block products are plain loops:
+/// for the few columns of a projection (n_z) faer's dispatch costs more
+/// than the arithmetic.
+const PLAIN_UP_TO: usize = 8;
+
+/// dst = a b: plain dot products when b has at most [`PLAIN_UP_TO`]
+/// columns and the rows of a and columns of b and dst are contiguous,
+/// else faer.
+fn product(mut dst: MatMut<'_, f64>, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
+    if b.ncols() <= PLAIN_UP_TO && a.row_stride() == a.ncols() as isize && a.col_stride() == 1 {
+        if let (Some(bs), true) = (contiguous_columns(b), dst.row_stride() == 1) {
+            let av = contiguous_rows(a);
+            for (c, bc) in bs.enumerate() {
+                let dc = dst
+                    .as_mut()
+                    .col_mut(c)
+                    .try_as_col_major_mut()
+                    .expect("contiguous");
+                for (d, ar) in dc.as_slice_mut().iter_mut().zip(av.clone()) {
+                    *d = ar.iter().zip(bc).map(|(x, y)| x * y).sum();
+                }
+            }
+            return;
+        }
+    }
+    matmul(dst, Accum::Replace, a, b, 1.0, Par::Seq);
+}
+
+/// The lower triangle of wᵀw, added to or replacing dst's: plain loops for
+/// at most [`PLAIN_UP_TO`] columns of w with contiguous columns, else faer.
+fn gram_lower(mut dst: MatMut<'_, f64>, w: MatRef<'_, f64>, accum: Accum) {
+    if let (Some(cols), true) = (contiguous_columns(w), w.ncols() <= PLAIN_UP_TO) {
+        for (j, wj) in cols.clone().enumerate() {
+            for (i, wi) in cols.clone().enumerate().skip(j) {
+                let v: f64 = wi.iter().zip(wj).map(|(x, y)| x * y).sum();
+                dst[(i, j)] = match accum {
+                    Accum::Add => dst[(i, j)] + v,
+                    Accum::Replace => v,
+                };
+            }
+        }
+        return;
+    }
+    tri_matmul(
+        dst,
+        BlockStructure::TriangularLower,
+        accum,
+        w.transpose(),
+        BlockStructure::Rectangular,
+        w,
+        BlockStructure::Rectangular,
+        1.0,
+        Par::Seq,
+    );
+}
+
+/// The columns of m as slices, if they are contiguous.
+fn contiguous_columns<'a>(m: MatRef<'a, f64>) -> Option<impl Iterator<Item = &'a [f64]> + Clone> {
+    (m.row_stride() == 1 || m.nrows() <= 1).then(|| {
+        (0..m.ncols()).map(move |c| {
+            m.col(c)
+                .try_as_col_major()
+                .expect("unit row stride")
+                .as_slice()
+        })
+    })
+}
+
+/// The rows of a row-major m as slices.
+fn contiguous_rows<'a>(m: MatRef<'a, f64>) -> impl Iterator<Item = &'a [f64]> + Clone {
+    (0..m.nrows()).map(move |r| {
+        m.row(r)
+            .try_as_row_major()
+            .expect("unit column stride")
+            .as_slice()
+    })
 }
 
 /// Adds the lower triangle of the compact block `c` on the (ascending) index
@@ -221,6 +284,62 @@ fn add_lower(mq: &mut Mat<f64>, c: MatRef<'_, f64>, idx: &[usize]) {
             col[ib] += c[(b, a)];
         }
     }
+}
+
+/// The element loop of the inertia: w −= Mx ẍ + h element by element at the
+/// nodal state (x, ẋ, ẍ), and, with `mass` = (work arrays, F, M), the mass
+/// M = Fᵀ Mx F by element blocks ([`Assembly`]), symmetric on return. Reads
+/// `stop` every [`STOP_CHECK_ELEMENTS`] elements while M is assembled and
+/// returns false, M incomplete, when it is set.
+pub(crate) fn inertia_pass(
+    mech: &Mechanism,
+    (x, xd, xdd): (&[f64], &[f64], &[f64]),
+    w: &mut [f64],
+    mut mass: Option<(&mut Assembly, MatRef<'_, f64>, &mut Mat<f64>)>,
+    stop: Option<&AtomicBool>,
+) -> bool {
+    if let Some((asm, _, m)) = mass.as_mut() {
+        m.fill(0.0);
+        asm.pending = 0;
+    }
+    let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+    let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+    let mut al = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+    let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
+    for (ei, e) in mech.elements.iter().enumerate() {
+        if let Some((asm, _, _)) = mass.as_mut() {
+            if ei % STOP_CHECK_ELEMENTS == 0 && crate::simulate::check_stop(stop).is_err() {
+                // the stacked blocks are dropped: the next assembly starts afresh
+                asm.pending = 0;
+                asm.rows = 0;
+                return false;
+            }
+        }
+        if !e.element.has_inertia() {
+            continue;
+        }
+        let n = e.x_index.len();
+        e.gather(x, &mut xl[..n]);
+        e.gather(xd, &mut vl[..n]);
+        e.gather(xdd, &mut al[..n]);
+        e.element
+            .inertia_force(&xl[..n], &vl[..n], &al[..n], &mut fl[..n]);
+        e.scatter_add(&fl[..n], -1.0, w);
+        if let Some((asm, f, m)) = mass.as_mut() {
+            asm.add_element(ei, &e.element, &xl[..n], *f, m);
+        }
+    }
+    if let Some((asm, _, m)) = mass {
+        asm.flush(m);
+        // mirror the lower triangle
+        let n = m.nrows();
+        for c in 0..n {
+            for r in c + 1..n {
+                m[(c, r)] = m[(r, c)];
+            }
+        }
+    }
+    true
 }
 
 /// The dynamics of one mechanism: kinematics plus forces; holds all buffers.
@@ -238,6 +357,9 @@ pub struct Dynamics {
     asm: Assembly,
     /// Set-up and work memory of the nodal-coordinate solve of q̈.
     pub(crate) nodal: NodalEom,
+    /// Work memory of the projected equations of a reduced model (made on
+    /// their first evaluation).
+    pub(crate) projection: Option<crate::projected::Projection>,
     /// The Cholesky factor of Mq (lower triangle) and its workspace.
     llt: Mat<f64>,
     llt_mem: MemBuffer,
@@ -265,8 +387,9 @@ impl Dynamics {
             xdd: vec![0.0; n_x],
             mq: Mat::zeros(n_q, n_q),
             rhs: vec![0.0; n_q],
-            asm: Assembly::new(&mech),
+            asm: Assembly::new(&mech, n_q),
             nodal: NodalEom::new(&mech),
+            projection: None,
             llt: Mat::zeros(n_q, n_q),
             llt_mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(
                 n_q,
@@ -483,46 +606,8 @@ impl Dynamics {
             None => view.xdd0,
         };
         self.w.copy_from_slice(&self.f);
-        let asm = &mut self.asm;
-        if mass {
-            self.mq.fill(0.0);
-            asm.pending = 0;
-        }
-        let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
-        let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
-        let mut al = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
-        let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
-        for (ei, e) in mech.elements.iter().enumerate() {
-            if mass && ei % STOP_CHECK_ELEMENTS == 0 && crate::simulate::check_stop(stop).is_err() {
-                // the stacked blocks are dropped: the next assembly starts afresh
-                asm.pending = 0;
-                asm.rows = 0;
-                return false;
-            }
-            if !e.element.has_inertia() {
-                continue;
-            }
-            let n = e.x_index.len();
-            e.gather(x, &mut xl[..n]);
-            e.gather(xd, &mut vl[..n]);
-            e.gather(xdd, &mut al[..n]);
-            e.element
-                .inertia_force(&xl[..n], &vl[..n], &al[..n], &mut fl[..n]);
-            e.scatter_add(&fl[..n], -1.0, &mut self.w);
-            if mass {
-                asm.add_element(ei, &e.element, &xl[..n], fq, n_q, &mut self.mq);
-            }
-        }
-        if mass {
-            asm.flush(&mut self.mq);
-            // mirror the lower triangle
-            for c in 0..n_q {
-                for r in c + 1..n_q {
-                    self.mq[(c, r)] = self.mq[(r, c)];
-                }
-            }
-        }
-        true
+        let mass = mass.then_some((&mut self.asm, fq.subcols(0, n_q), &mut self.mq));
+        inertia_pass(&mech, (x, xd, xdd), &mut self.w, mass, stop)
     }
 
     /// rhs = F,qᵀ w − E,qᵀ σ.

@@ -47,6 +47,7 @@ mod momentum;
 mod nodal_eom;
 mod outputs;
 mod partition;
+mod projected;
 mod reactions;
 mod simulate;
 mod statics;

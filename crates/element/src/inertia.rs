@@ -60,10 +60,56 @@ pub(crate) struct SpatialInertia {
 }
 
 /// An upper-triangular U with A = UᵀU (row-major n × n) of a symmetric positive
-/// semi-definite A (row-major): Cholesky, where a pivot below 1e-13 of the
-/// largest diagonal entry gives a zero row (a massless direction). `None` if A
-/// is indefinite.
+/// semi-definite A (row-major). `None` if A is indefinite.
+///
+/// The coordinates of an element's mass matrix have their own units (m/s,
+/// rad/s, the rad/(m s) of a warping rate), so its diagonal spans many
+/// decades: a 10 × 0.5 mm sheet beam's warping inertia ρI_w l is 7e-14 of its
+/// translational mass, whatever its length. The pivots are therefore judged
+/// in the Jacobi-scaled matrix D⁻¹AD⁻¹ (D² = diag A, unit diagonal): a zero
+/// diagonal entry, or a pivot below 1e-13 of its own diagonal entry, is a
+/// massless direction (a zero row), and U = Û D. Where the scaled matrix is
+/// not found semi-definite (a diagonal entry at rounding level with couplings
+/// of the same size), the pivots are judged against the largest diagonal
+/// entry instead ([`psd_factor_unscaled`]).
 pub(crate) fn psd_factor(a: &[f64], n: usize) -> Option<Vec<f64>> {
+    let scale = (0..n).fold(0.0f64, |m, i| m.max(a[i * n + i].abs()));
+    // a NaN diagonal entry is refused too
+    if (0..n).any(|i| a[i * n + i].is_nan() || a[i * n + i] < -1e-13 * scale) {
+        return None;
+    }
+    let d: Vec<f64> = (0..n).map(|i| a[i * n + i].max(0.0).sqrt()).collect();
+    // off-diagonal entries of a massless coordinate must vanish (as in the
+    // unscaled factor); the scaled matrix leaves them out
+    let scaled: Vec<f64> = (0..n * n)
+        .map(|k| {
+            let (i, j) = (k / n, k % n);
+            if d[i] > 0.0 && d[j] > 0.0 {
+                a[k] / (d[i] * d[j])
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let massless_rows_vanish = (0..n * n).all(|k| {
+        let (i, j) = (k / n, k % n);
+        (d[i] > 0.0 && d[j] > 0.0) || a[k].abs() <= 1e-6 * scale
+    });
+    if massless_rows_vanish {
+        if let Some(mut u) = psd_factor_unscaled(&scaled, n) {
+            for k in 0..n * n {
+                u[k] *= d[k % n];
+            }
+            return Some(u);
+        }
+    }
+    psd_factor_unscaled(a, n)
+}
+
+/// [`psd_factor`] with every pivot judged against the largest diagonal
+/// entry: Cholesky, where a pivot below 1e-13 of it gives a zero row (a
+/// massless direction). `None` if A is indefinite.
+fn psd_factor_unscaled(a: &[f64], n: usize) -> Option<Vec<f64>> {
     let scale = (0..n).fold(0.0f64, |m, i| m.max(a[i * n + i].abs()));
     let tol = 1e-13 * scale;
     let mut u = vec![0.0; n * n];
@@ -1153,5 +1199,53 @@ mod tests {
         }
         assert!(psd_factor(&[1.0, 2.0, 2.0, 1.0], 2).is_none());
         assert!(psd_factor(&[0.0, 1.0, 1.0, 1.0], 2).is_none());
+    }
+
+    /// A mass whose diagonal spans 20 decades (the warping rate of a thin
+    /// sheet beam next to its translations) keeps every direction: UᵀU = A
+    /// entry by entry to rounding, relative to the entry's own scale, and a
+    /// singular combination of two massive coordinates is still massless.
+    #[test]
+    fn psd_factor_keeps_tiny_inertia_in_other_units() {
+        let (big, tiny) = (3.4e-5, 2.3e-18);
+        // (big, big coupled singularly), then a 2 × 2 warping-like block
+        let a = [
+            big,
+            big,
+            0.0,
+            0.0, //
+            big,
+            big,
+            0.0,
+            0.0, //
+            0.0,
+            0.0,
+            tiny,
+            -0.25 * tiny, //
+            0.0,
+            0.0,
+            -0.25 * tiny,
+            tiny,
+        ];
+        let u = psd_factor(&a, 4).unwrap();
+        for i in 0..4 {
+            for j in 0..4 {
+                let v: f64 = (0..4).map(|k| u[k * 4 + i] * u[k * 4 + j]).sum();
+                let s = (a[i * 4 + i] * a[j * 4 + j]).sqrt();
+                assert!(
+                    (v - a[i * 4 + j]).abs() <= 1e-14 * s,
+                    "({i}, {j}): {v} vs {}",
+                    a[i * 4 + j]
+                );
+            }
+        }
+        // the singular pair leaves one zero row, the tiny block two rows
+        let rows = (0..4)
+            .filter(|k| (0..4).any(|j| u[k * 4 + j] != 0.0))
+            .count();
+        assert_eq!(rows, 3);
+        // the unscaled rule would have called the tiny block massless
+        let old = psd_factor_unscaled(&a, 4).unwrap();
+        assert_eq!(old[2 * 4 + 2], 0.0);
     }
 }

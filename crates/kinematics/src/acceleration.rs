@@ -1,9 +1,9 @@
 //! The convective terms D,xx\[ẋ, ẋ\] and the accelerations for q̈ = 0,
 //! ẍ0 = F,u ü + (F,ξξ ξ̇)ξ̇ and ε̈0, by one more solve with J
-//! (thesis (5.8b), (6.6b)).
+//! (thesis (5.8b), (6.6b)); and ẍ for a given q̈ in one refined solve.
 
-use crate::Kinematics;
-use flexmb_model::{Coordinate, ERole, XRole};
+use crate::{Kinematics, KinematicsError};
+use flexmb_model::ERole;
 
 impl Kinematics {
     /// The convective terms D,xx\[ẋ, ẋ\] of every deformation at the current
@@ -39,57 +39,29 @@ impl Kinematics {
     /// [`velocities`](Self::velocities). Then ẍ = F,q q̈ + ẍ0.
     pub fn accelerations(&mut self) {
         self.ensure_lu_at_x();
-        let n_u = self.n_u;
-        let mech = self.mech.clone();
         // c = D,xx[ẋ, ẋ] per element
         self.convective_terms();
         self.epsdd0.copy_from_slice(&self.dxx_vv);
+        // the direction ξ̈ = (0, ü)
+        let mut dir = std::mem::take(&mut self.xi_dir);
+        self.second_derivative_direction(None, &mut dir);
         let mut rhs = std::mem::take(&mut self.rhs_vec);
-        for (r, j) in mech.constraint_rows.iter().enumerate() {
-            rhs[r] = -self.dxx_vv[*j];
-        }
-        // prescribed input accelerations ü
-        let mut udd = vec![0.0; n_u];
-        for k in 0..n_u {
-            udd[k] = mech.inputs[k].function.eval(self.t).2;
-            if let Coordinate::Def(j) = mech.inputs[k].target {
-                if let Some(r) = self.row_of[j] {
-                    rhs[r] += udd[k];
-                }
-            }
-        }
-        for (ei, e) in mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
-            for (cc, gi) in e.x_index.iter().enumerate() {
-                if let XRole::Input(k) = mech.x_roles[*gi] {
-                    for (a, r) in m.rows.iter().enumerate() {
-                        if let Some(r) = r {
-                            rhs[*r] -= jl[a * m.nx + cc] * udd[k];
-                        }
-                    }
-                }
-            }
-        }
+        self.direction_rhs(&dir, true, &mut rhs);
         self.lu.solve_vec(&mut rhs);
-        self.xdd0.fill(0.0);
-        for (k, &i) in mech.dependent.iter().enumerate() {
-            self.xdd0[i] = rhs[k];
-        }
-        for (i, r) in mech.x_roles.iter().enumerate() {
-            if let XRole::Input(k) = r {
-                self.xdd0[i] = udd[*k];
-            }
-        }
+        let mut xdd0 = std::mem::take(&mut self.xdd0);
+        self.scatter_direction(&dir, &rhs, &mut xdd0);
+        self.xdd0 = xdd0;
+        self.rhs_vec = rhs;
         // ε̈0 = D,x ẍ0 + D,xx[ẋ, ẋ] (rows: exact targets)
-        for (ei, e) in mech.elements.iter().enumerate() {
+        let n_q = self.n_q;
+        for (ei, e) in self.mech.elements.iter().enumerate() {
             let m = &self.maps[ei];
             let jl = &self.jac_local[ei];
             for a in 0..m.ne {
                 let j = e.eps_offset + a;
                 if self.row_of[j].is_some() {
-                    self.epsdd0[j] = match mech.e_roles[j] {
-                        ERole::Input(k) => udd[k],
+                    self.epsdd0[j] = match self.mech.e_roles[j] {
+                        ERole::Input(k) => dir[n_q + k],
                         _ => 0.0,
                     };
                     continue;
@@ -101,6 +73,45 @@ impl Kinematics {
                 self.epsdd0[j] = s;
             }
         }
-        self.rhs_vec = rhs;
+        self.xi_dir = dir;
+    }
+
+    /// The nodal accelerations ẍ = F,q q̈ + F,u ü + (F,ξξ ξ̇)ξ̇ for the given
+    /// q̈ (n_q entries) at the current configuration and velocities (after
+    /// [`velocities_refined`](Self::velocities_refined) or
+    /// [`velocities`](Self::velocities)), into `xdd` (n_x entries), without
+    /// F,ξ: D,xx\[ẋ, ẋ\] ([`convective_terms`](Self::convective_terms),
+    /// updated here) and one solve of the constraint equations
+    /// differentiated twice (thesis (5.8b)), refined against the exact J(x)
+    /// as the velocities are. A reduced model's q̈ = G,z z̈ + (G,zz ż)ż
+    /// needs it for q̈ = (G,zz ż)ż: the whole convective part of ẍ in one
+    /// solve (thesis (6.15)).
+    pub fn accelerations_refined(
+        &mut self,
+        qdd: &[f64],
+        xdd: &mut [f64],
+    ) -> Result<(), KinematicsError> {
+        self.check_lengths(&[
+            ("q̈", qdd.len(), self.n_q),
+            ("ẍ", xdd.len(), self.mech.n_x()),
+        ])?;
+        self.convective_terms();
+        let mut dir = std::mem::take(&mut self.xi_dir);
+        self.second_derivative_direction(Some(qdd), &mut dir);
+        let solved = self.solve_direction(&dir, true, xdd);
+        self.xi_dir = dir;
+        solved
+    }
+
+    /// ξ̈ = (q̈, ü(t)) into `dir`, q̈ = 0 when not given.
+    fn second_derivative_direction(&self, qdd: Option<&[f64]>, dir: &mut [f64]) {
+        let n_q = self.n_q;
+        match qdd {
+            Some(qdd) => dir[..n_q].copy_from_slice(qdd),
+            None => dir[..n_q].fill(0.0),
+        }
+        for (k, u) in self.mech.inputs.iter().enumerate() {
+            dir[n_q + k] = u.function.eval(self.t).2;
+        }
     }
 }

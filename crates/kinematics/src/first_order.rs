@@ -2,7 +2,7 @@
 //! (thesis (5.8a), (6.6a)), and the products with them that need no F,ξ
 //! matrix.
 
-use crate::Kinematics;
+use crate::{Kinematics, KinematicsError};
 use faer::Mat;
 
 /// A read-only view of the kinematic state whose F,ξ and E,ξ are of its
@@ -87,17 +87,8 @@ impl Kinematics {
     /// the nodal coordinates x_i that belong to ξ (k = ξ index of x_i): the
     /// nodal columns of the right-hand side B of (5.8a), up to sign.
     pub(crate) fn for_each_nodal_xi_entry(&self, mut visit: impl FnMut(usize, usize, f64)) {
-        for (ei, e) in self.mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
-            for (c, gi) in e.x_index.iter().enumerate() {
-                let Some(k) = self.xi_of_x[*gi] else { continue };
-                for (a, r) in m.rows.iter().enumerate() {
-                    if let Some(r) = r {
-                        visit(*r, k, jl[a * m.nx + c]);
-                    }
-                }
-            }
+        for e in &self.xi_entries {
+            visit(e.row, e.col, self.jac_local[e.element][e.local]);
         }
     }
 
@@ -129,6 +120,75 @@ impl Kinematics {
             }
         }
         self.rhs_vec = mu;
+    }
+
+    /// F,q V into `out` (n_x × k) for k directions of the degrees of
+    /// freedom, the columns of V (n_q × k), without F,ξ: one block solve
+    /// J Y_dep = B [V; 0] (thesis (5.8a) along each column). With a
+    /// reduction basis G,z as V this is the reduced transfer matrix
+    /// F,z = F,q G,z of (6.15): k solves instead of the n_q + n_u of F,ξ.
+    /// J is factorized at x first if its factorization is of another
+    /// configuration (after [`solve_chord`](Self::solve_chord)); the solves
+    /// that follow (velocities, accelerations) are then direct too. Refining
+    /// the block against the old factorization instead, as the velocities
+    /// are ([`velocities_refined`](Self::velocities_refined)), measured 8 %
+    /// more instructions per evaluation for MSI-2 of the spatial guidance
+    /// (33-row J, k = 2) and 40 % more for a 13-mode basis of it (77 rows).
+    /// Allocates only when k changes.
+    ///
+    /// # Errors
+    ///
+    /// [`KinematicsError::Length`] when V does not have n_q rows or `out`
+    /// is not n_x × k; a singular J as from the position solve.
+    pub fn transfer_matrix(
+        &mut self,
+        v: faer::MatRef<'_, f64>,
+        mut out: faer::MatMut<'_, f64>,
+    ) -> Result<(), KinematicsError> {
+        let (n_q, k) = (self.n_q, v.ncols());
+        self.check_lengths(&[
+            ("the rows of V", v.nrows(), n_q),
+            ("the rows of F,q V", out.nrows(), self.mech.n_x()),
+            ("the columns of F,q V", out.ncols(), k),
+        ])?;
+        if !(self.lu_valid && self.lu_at_x) {
+            self.factor_at_x()?;
+        }
+        let n_c = self.mech.constraint_rows.len();
+        if self.block.ncols() != k || self.block.nrows() != n_c {
+            self.block = Mat::zeros(n_c, k);
+        }
+        let mut dir = std::mem::take(&mut self.xi_dir);
+        let mut block = std::mem::replace(&mut self.block, Mat::new());
+        dir[n_q..].fill(0.0);
+        for c in 0..k {
+            for (i, d) in dir[..n_q].iter_mut().enumerate() {
+                *d = v[(i, c)];
+            }
+            self.direction_rhs(&dir, false, block.col_as_slice_mut(c));
+        }
+        self.lu.solve_in_place(block.as_mut());
+        for c in 0..k {
+            for (i, d) in dir[..n_q].iter_mut().enumerate() {
+                *d = v[(i, c)];
+            }
+            let dst = out.as_mut().col_mut(c);
+            match dst.try_as_col_major_mut() {
+                Some(d) => self.scatter_direction(&dir, block.col_as_slice(c), d.as_slice_mut()),
+                None => {
+                    // (a strided destination: through the work vector)
+                    let mut w = std::mem::take(&mut self.work);
+                    self.scatter_direction(&dir, block.col_as_slice(c), &mut w[..self.mech.n_x()]);
+                    for (i, x) in w[..self.mech.n_x()].iter().enumerate() {
+                        out[(i, c)] = *x;
+                    }
+                    self.work = w;
+                }
+            }
+        }
+        self.xi_dir = dir;
+        self.block = block;
+        Ok(())
     }
 
     /// y += D,xᵀ s, the nodal forces of deformation stresses s (all

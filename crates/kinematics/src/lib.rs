@@ -73,6 +73,16 @@ struct ElemMap {
     ne: usize,
 }
 
+/// An entry ∂D_r/∂x_i of a constraint row r with respect to a nodal
+/// coordinate x_i in ξ (ξ index `col`): position `local` in the element
+/// Jacobian of `element`.
+struct XiEntry {
+    row: usize,
+    col: usize,
+    element: usize,
+    local: usize,
+}
+
 /// Transfer functions and their derivatives for one mechanism; holds the
 /// current configuration and all work buffers (allocated once).
 pub struct Kinematics {
@@ -87,6 +97,14 @@ pub struct Kinematics {
     /// ξ index of each coordinate: nodal coordinate → Some(k), deformation → Some(k)
     xi_of_x: Vec<Option<usize>>,
     xi_of_e: Vec<Option<usize>>,
+    /// The entries of D_c,x_ξ, the nodal columns of the right-hand side B of
+    /// (5.8a), element by element (products with directions of ξ).
+    xi_entries: Vec<XiEntry>,
+    /// The rows of J element by element, as (constraint row, (element, range
+    /// of `dep_entries`)), with `dep_entries` (dependent column, position in
+    /// the element Jacobian): products J v at the current x.
+    dep_rows: Vec<(usize, (usize, std::ops::Range<usize>))>,
+    dep_entries: Vec<(usize, usize)>,
     length_scale: f64,
     n_q: usize,
     n_u: usize,
@@ -98,6 +116,9 @@ pub struct Kinematics {
     eps: Vec<f64>,
     prev_eps: Vec<f64>,
     jac_local: Vec<Vec<f64>>,
+    /// The element Jacobians are of the current x (the last element
+    /// evaluation computed them).
+    jac_at_x: bool,
     /// LU of J (sparse, or dense when small); `jpos[k][a·n_x,e + c]` is the position of element k's
     /// local entry (a, c) in its values (`NO_ENTRY` when not in J).
     lu: JacobianLu,
@@ -110,6 +131,12 @@ pub struct Kinematics {
     have_solution: bool,
     // velocity level
     xid: Vec<f64>,
+    /// A direction of ξ (q̈ and ü, or a direction of q) for the solves
+    /// along one.
+    xi_dir: Vec<f64>,
+    /// The right-hand sides of a block of directions
+    /// ([`transfer_matrix`](Kinematics::transfer_matrix)).
+    block: Mat<f64>,
     xd: Vec<f64>,
     epsd: Vec<f64>,
     // acceleration level
@@ -263,6 +290,7 @@ impl Kinematics {
     /// as the starting guess of the next solve.
     pub fn set_guess(&mut self, x: &[f64]) {
         self.x.copy_from_slice(x);
+        self.jac_at_x = false;
         self.have_solution = false;
         self.lu_at_x = false;
         self.first_order_valid = false;
@@ -314,5 +342,21 @@ impl Kinematics {
     /// the last solution in equal steps of ξ.
     pub fn continuations(&self) -> u64 {
         self.continuations
+    }
+
+    /// `Ok` if every (name, length, needed) has its length, else the
+    /// [`KinematicsError::Length`] of the first that does not.
+    pub(crate) fn check_lengths(
+        &self,
+        args: &[(&'static str, usize, usize)],
+    ) -> Result<(), KinematicsError> {
+        match args.iter().find(|(_, got, expected)| got != expected) {
+            None => Ok(()),
+            Some(&(what, got, expected)) => Err(KinematicsError::Length {
+                what,
+                expected,
+                got,
+            }),
+        }
     }
 }

@@ -45,7 +45,11 @@ enum Refactor {
 }
 
 impl Kinematics {
+    /// ε = D(x) of every element at the current x, with the element
+    /// Jacobians D,x if `with_jac` (dual numbers: several times the cost of
+    /// ε alone for a spatial beam, which Newton's trial steps need only).
     fn eval_elements(&mut self, with_jac: bool) {
+        self.jac_at_x = with_jac;
         let mech = &self.mech;
         let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (k, e) in mech.elements.iter().enumerate() {
@@ -79,20 +83,21 @@ impl Kinematics {
             if o.len() != 4 {
                 continue;
             }
-            let deps: Vec<usize> = o
-                .iter()
-                .copied()
-                .filter(|i| matches!(self.mech.x_roles[*i], XRole::Dependent(_)))
-                .collect();
+            // (counted, not collected: this runs at every solve)
+            let is_dep = |i: &&usize| matches!(self.mech.x_roles[**i], XRole::Dependent(_));
+            let deps = o.iter().filter(is_dep).count();
             let dofs = o
                 .iter()
                 .filter(|i| matches!(self.mech.x_roles[**i], XRole::Dof(_)))
                 .count();
-            if deps.len() == 1 && dofs == 3 && self.x[deps[0]].abs() < 0.05 {
+            let Some(&dep) = o.iter().find(is_dep) else {
+                continue;
+            };
+            if deps == 1 && dofs == 3 && self.x[dep].abs() < 0.05 {
                 return Err(KinematicsError::EulerParameterDegenerate {
                     node: n.id.clone(),
-                    coordinate: self.mech.x_names[deps[0]].clone(),
-                    value: self.x[deps[0]],
+                    coordinate: self.mech.x_names[dep].clone(),
+                    value: self.x[dep],
                 });
             }
         }
@@ -106,6 +111,15 @@ impl Kinematics {
             .enumerate()
             .map(|(r, j)| (self.eps[*j] - self.target[r]).abs())
             .fold(0.0f64, f64::max)
+    }
+
+    /// Evaluates the element Jacobians at the current x if the last
+    /// evaluation was of ε only (ε does not change: the plain and the dual
+    /// evaluation give it bit for bit alike).
+    fn ensure_jacobians(&mut self) {
+        if !self.jac_at_x {
+            self.eval_elements(true);
+        }
     }
 
     /// Scatters the element Jacobians into the values of J.
@@ -278,7 +292,8 @@ impl Kinematics {
         last_update.fill(0.0);
         let mut lu_fresh_for_steps = self.lu_valid;
         let mut prev_res = f64::INFINITY;
-        self.eval_elements(true);
+        // ε only; the Jacobians where J is factorized and at the solution
+        self.eval_elements(false);
         let mut res = self.load_residual();
         let mut outcome = None;
         for it in 0..=self.opts.max_iterations {
@@ -332,7 +347,7 @@ impl Kinematics {
             let mut step = 1.0;
             loop {
                 self.add_to_dependent(step);
-                self.eval_elements(true);
+                self.eval_elements(false);
                 let trial = self.residual_norm();
                 if (trial.is_finite() && (trial < res || res < 1e3 * tol)) || step < 0.04 {
                     // the smallest step is accepted anyway: Newton may still recover
@@ -375,6 +390,7 @@ impl Kinematics {
 
     /// Bookkeeping of a converged solve (and the factorization `mode` asks for).
     fn converged(&mut self, it: usize, mode: Refactor) -> Result<(), KinematicsError> {
+        self.ensure_jacobians();
         if mode == Refactor::AtSolution && !self.lu_at_x {
             self.factor_at_x()?;
         }
@@ -387,6 +403,7 @@ impl Kinematics {
 
     /// Factorizes J at the current x (element Jacobians evaluated there).
     pub(crate) fn factor_at_x(&mut self) -> Result<(), KinematicsError> {
+        self.ensure_jacobians();
         self.assemble_jacobian();
         self.factorizations += 1;
         self.extra_refinements = 0;

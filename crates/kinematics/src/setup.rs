@@ -4,7 +4,7 @@
 //! (thesis (5.7), (6.5)), the pattern of J and the work buffers.
 
 use crate::jacobian_lu::{JacobianLu, DENSE_UP_TO};
-use crate::{ElemMap, Kinematics, NewtonOptions, NO_ENTRY};
+use crate::{ElemMap, Kinematics, NewtonOptions, XiEntry, NO_ENTRY};
 use faer::Mat;
 use flexmb_model::{Coordinate, Mechanism, XRole};
 use std::sync::Arc;
@@ -64,6 +64,7 @@ impl Kinematics {
                 }
             })
             .collect();
+        let (xi_entries, dep_rows, dep_entries) = jacobian_entries(&mech, &maps, &xi_of_x);
         let length_scale = characteristic_length(&mech);
         let jac_local = mech
             .elements
@@ -87,6 +88,9 @@ impl Kinematics {
             row_of,
             xi_of_x,
             xi_of_e,
+            xi_entries,
+            dep_rows,
+            dep_entries,
             length_scale,
             n_q,
             n_u,
@@ -97,6 +101,7 @@ impl Kinematics {
             eps: vec![0.0; n_eps],
             prev_eps: vec![0.0; n_eps],
             jac_local,
+            jac_at_x: false,
             lu,
             jpos,
             free_deformations,
@@ -105,6 +110,8 @@ impl Kinematics {
             first_order_valid: false,
             have_solution: false,
             xid: vec![0.0; n_xi],
+            xi_dir: vec![0.0; n_xi],
+            block: Mat::zeros(0, 0),
             xd: vec![0.0; n_x],
             epsd: vec![0.0; n_eps],
             xdd0: vec![0.0; n_x],
@@ -162,6 +169,50 @@ fn jacobian_pattern(
         jpos[k][local] = p;
     }
     (lu, jpos)
+}
+
+/// The entries of the constraint rows with respect to the nodal coordinates
+/// in ξ, and the rows of J with their dependent columns, element by element
+/// (see the fields `xi_entries`, `dep_rows` and `dep_entries` of
+/// [`Kinematics`]).
+#[allow(clippy::type_complexity)]
+fn jacobian_entries(
+    mech: &Mechanism,
+    maps: &[ElemMap],
+    xi_of_x: &[Option<usize>],
+) -> (
+    Vec<XiEntry>,
+    Vec<(usize, (usize, std::ops::Range<usize>))>,
+    Vec<(usize, usize)>,
+) {
+    let mut xi_entries = vec![];
+    let (mut dep_rows, mut dep_entries) = (vec![], vec![]);
+    for (ei, (e, m)) in mech.elements.iter().zip(maps).enumerate() {
+        for (c, gi) in e.x_index.iter().enumerate() {
+            let Some(col) = xi_of_x[*gi] else { continue };
+            for (a, r) in m.rows.iter().enumerate() {
+                if let Some(row) = r {
+                    xi_entries.push(XiEntry {
+                        row: *row,
+                        col,
+                        element: ei,
+                        local: a * m.nx + c,
+                    });
+                }
+            }
+        }
+        for (a, r) in m.rows.iter().enumerate() {
+            let Some(r) = r else { continue };
+            let start = dep_entries.len();
+            for (c, col) in m.cols.iter().enumerate() {
+                if let Some(k) = col {
+                    dep_entries.push((*k, a * m.nx + c));
+                }
+            }
+            dep_rows.push((*r, (ei, start..dep_entries.len())));
+        }
+    }
+    (xi_entries, dep_rows, dep_entries)
 }
 
 /// Mean distance between the first two position slots of the elements that

@@ -63,37 +63,64 @@ impl Kinematics {
     /// if the refinement does not contract fast. ε̇ is exact on the constraint
     /// rows and D,x ẋ elsewhere.
     pub fn velocities_refined(&mut self, qd: &[f64]) -> Result<(), KinematicsError> {
-        let (n_q, n_u) = (self.n_q, self.n_u);
+        self.set_xi_rates(qd);
+        let xid = std::mem::take(&mut self.xid);
+        let mut xd = std::mem::take(&mut self.xd);
+        let solved = self.solve_direction(&xid, false, &mut xd);
+        self.xid = xid;
+        self.xd = xd;
+        solved?;
+        self.deformation_rates();
+        Ok(())
+    }
+
+    /// ẋ and ε̇ for q̇ (n_q entries) whose nodal velocity F,q q̇ (n_x
+    /// entries) the caller already has, e.g. F,z ż of a reduced model from
+    /// the columns F,z = F,q G,z ([`transfer_matrix`](Self::transfer_matrix)):
+    /// ẋ = F,q q̇ + F,u u̇(t), the inputs' part by one solve as in
+    /// [`velocities_refined`](Self::velocities_refined) (none when no input
+    /// moves), and ε̇ from ẋ. The result is that of `velocities_refined(q̇)`
+    /// to rounding if `fq_qd` is F,q q̇ at the current configuration.
+    pub fn velocities_from(&mut self, qd: &[f64], fq_qd: &[f64]) -> Result<(), KinematicsError> {
+        self.check_lengths(&[
+            ("q̇", qd.len(), self.n_q),
+            ("F,q q̇", fq_qd.len(), self.mech.n_x()),
+        ])?;
+        self.set_xi_rates(qd);
+        let n_q = self.n_q;
+        let mut xd = std::mem::take(&mut self.xd);
+        let mut solved = Ok(());
+        if self.xid[n_q..].iter().any(|v| *v != 0.0) {
+            let mut dir = std::mem::take(&mut self.xi_dir);
+            dir[..n_q].fill(0.0);
+            dir[n_q..].copy_from_slice(&self.xid[n_q..]);
+            solved = self.solve_direction(&dir, false, &mut xd);
+            self.xi_dir = dir;
+            for (v, a) in xd.iter_mut().zip(fq_qd) {
+                *v += a;
+            }
+        } else {
+            xd.copy_from_slice(fq_qd);
+        }
+        self.xd = xd;
+        solved?;
+        self.deformation_rates();
+        Ok(())
+    }
+
+    /// ξ̇ = (q̇, u̇(t)).
+    fn set_xi_rates(&mut self, qd: &[f64]) {
+        let n_q = self.n_q;
         self.xid[..n_q].copy_from_slice(qd);
-        for k in 0..n_u {
-            self.xid[n_q + k] = self.mech.inputs[k].function.eval(self.t).1;
+        for (k, u) in self.mech.inputs.iter().enumerate() {
+            self.xid[n_q + k] = u.function.eval(self.t).1;
         }
-        let mut rhs = std::mem::take(&mut self.vel_rhs);
-        for (r, j) in self.mech.constraint_rows.iter().enumerate() {
-            rhs[r] = match self.mech.e_roles[*j] {
-                ERole::Dof(k) => self.xid[k],
-                ERole::Input(k) => self.xid[n_q + k],
-                _ => 0.0,
-            };
-        }
-        let xid = &self.xid;
-        self.for_each_nodal_xi_entry(|r, k, d| rhs[r] -= d * xid[k]);
-        let mut v = std::mem::take(&mut self.rhs_vec);
-        let solved = self.solve_refined(&rhs, &mut v);
-        self.vel_rhs = rhs;
-        if let Err(e) = solved {
-            self.rhs_vec = v;
-            return Err(e);
-        }
-        for (i, r) in self.mech.x_roles.iter().enumerate() {
-            self.xd[i] = match r {
-                XRole::Fixed => 0.0,
-                XRole::Dof(k) => self.xid[*k],
-                XRole::Input(k) => self.xid[n_q + k],
-                XRole::Dependent(k) => v[*k],
-            };
-        }
-        self.rhs_vec = v;
+    }
+
+    /// ε̇ from ξ̇ and ẋ: exact on the constraint rows (the rate of the DOF or
+    /// input they are, or zero), D,x ẋ elsewhere.
+    fn deformation_rates(&mut self) {
+        let n_q = self.n_q;
         for (j, r) in self.mech.e_roles.iter().enumerate() {
             if self.row_of[j].is_some() {
                 self.epsd[j] = match r {
@@ -114,7 +141,62 @@ impl Kinematics {
                 .map(|(gi, d)| d * self.xd[*gi])
                 .sum();
         }
-        Ok(())
+    }
+
+    /// Solves the constraint equations differentiated along the direction
+    /// `dir` of ξ = (q, u), J y_dep = B dir (minus D_c,xx\[ẋ, ẋ\] on the
+    /// constraint rows when `convective`, the second time derivative (5.8b)),
+    /// with [`solve_refined`](Self::solve_refined), and writes y over all
+    /// nodal coordinates into `out`: `dir` on those in ξ, zero on the fixed
+    /// ones.
+    pub(crate) fn solve_direction(
+        &mut self,
+        dir: &[f64],
+        convective: bool,
+        out: &mut [f64],
+    ) -> Result<(), KinematicsError> {
+        let mut rhs = std::mem::take(&mut self.vel_rhs);
+        self.direction_rhs(dir, convective, &mut rhs);
+        let mut v = std::mem::take(&mut self.rhs_vec);
+        let solved = self.solve_refined(&rhs, &mut v);
+        if solved.is_ok() {
+            self.scatter_direction(dir, &v, out);
+        }
+        self.vel_rhs = rhs;
+        self.rhs_vec = v;
+        solved
+    }
+
+    /// The right-hand side B dir of J y_dep = B dir for a direction `dir`
+    /// of ξ (thesis (5.8a)): `dir`'s entry on the rows of degree-of-freedom
+    /// and prescribed deformations, minus D_c,x_i dir_i over the nodal
+    /// coordinates x_i in ξ; started from −D_c,xx\[ẋ, ẋ\] (of the last
+    /// [`convective_terms`](Self::convective_terms)) when `convective`.
+    pub(crate) fn direction_rhs(&self, dir: &[f64], convective: bool, rhs: &mut [f64]) {
+        let n_q = self.n_q;
+        for (r, j) in self.mech.constraint_rows.iter().enumerate() {
+            rhs[r] = if convective { -self.dxx_vv[*j] } else { 0.0 };
+            match self.mech.e_roles[*j] {
+                ERole::Dof(k) => rhs[r] += dir[k],
+                ERole::Input(k) => rhs[r] += dir[n_q + k],
+                _ => {}
+            }
+        }
+        self.for_each_nodal_xi_entry(|r, k, d| rhs[r] -= d * dir[k]);
+    }
+
+    /// A direction over all nodal coordinates from its ξ part `dir` and the
+    /// solved dependent part `dep` (zero on fixed coordinates).
+    pub(crate) fn scatter_direction(&self, dir: &[f64], dep: &[f64], out: &mut [f64]) {
+        let n_q = self.n_q;
+        for (i, r) in self.mech.x_roles.iter().enumerate() {
+            out[i] = match r {
+                XRole::Fixed => 0.0,
+                XRole::Dof(k) => dir[*k],
+                XRole::Input(k) => dir[n_q + k],
+                XRole::Dependent(k) => dep[*k],
+            };
+        }
     }
 
     /// Solves J(x) v = b at the solved configuration: directly when the
@@ -185,18 +267,13 @@ impl Kinematics {
 
     /// out −= J(x) v, J = ∂D_c/∂x_dep from the element Jacobians at x.
     fn sub_jacobian_times(&self, v: &[f64], out: &mut [f64]) {
-        for (m, jl) in self.maps.iter().zip(&self.jac_local) {
-            for (a, r) in m.rows.iter().enumerate() {
-                let Some(r) = r else { continue };
-                let row = &jl[a * m.nx..(a + 1) * m.nx];
-                let mut s = 0.0;
-                for (c, col) in m.cols.iter().enumerate() {
-                    if let Some(k) = col {
-                        s += row[c] * v[*k];
-                    }
-                }
-                out[*r] -= s;
-            }
+        for (r, (element, entries)) in &self.dep_rows {
+            let jl = &self.jac_local[*element];
+            let s: f64 = self.dep_entries[entries.clone()]
+                .iter()
+                .map(|(k, local)| jl[*local] * v[*k])
+                .sum();
+            out[*r] -= s;
         }
     }
 }

@@ -342,6 +342,151 @@ fn chord_solve_and_refined_velocities_match_the_full_solve() {
     }
 }
 
+/// The solves along directions that a reduced model uses, without F,ξ,
+/// against the products with F,ξ of a solve that factorizes J at every
+/// point, along a path of nearby configurations reached by chord solves:
+/// F,q V by `transfer_matrix` (a strided V too), the velocities from a known
+/// F,q q̇ by `velocities_from` (with moving inputs on the universal joint),
+/// and ẍ = F,q q̈ + ẍ0 by `accelerations_refined`. Deformation and nodal
+/// DOFs, dense and sparse factorizations; slices of the wrong size are
+/// errors.
+#[test]
+fn solves_along_directions_match_the_products_with_the_transfer_matrix() {
+    let cases = [
+        (
+            "straight_guidance_spatial.ron",
+            DofChoice::Deformations,
+            false,
+        ),
+        (
+            "straight_guidance_spatial.ron",
+            DofChoice::NodalCoordinates,
+            false,
+        ),
+        (
+            "straight_guidance_spatial.ron",
+            DofChoice::Deformations,
+            true,
+        ),
+        (
+            "straight_guidance_spatial.ron",
+            DofChoice::NodalCoordinates,
+            true,
+        ),
+        (
+            "spin_up_universal_joint.ron",
+            DofChoice::Deformations,
+            false,
+        ),
+    ];
+    for (name, dofs, sparse) in cases {
+        let make = || {
+            if sparse {
+                sparse_kinematics(name, dofs.clone())
+            } else {
+                kinematics(name, dofs.clone())
+            }
+        };
+        let (mut k, mut full) = (make(), make());
+        let (nq, nx) = (k.n_q(), k.mechanism().n_x());
+        let mut rng = StdRng::seed_from_u64(5);
+        let start = deflected(&k, &mut rng, 2e-3);
+        let dir: Vec<f64> = (0..nq).map(|_| rng.random_range(-1.0..1.0)).collect();
+        // three directions, stored transposed (V strided) for the second pass
+        let v = faer::Mat::from_fn(nq, 3, |_, _| rng.random_range(-1.0..1.0));
+        let vt = v.transpose().to_owned();
+        let zd = [0.3, -0.2, 0.5];
+        let qd: Vec<f64> = (0..nq)
+            .map(|i| (0..3).map(|c| v[(i, c)] * zd[c]).sum())
+            .collect();
+        let qdd: Vec<f64> = (0..nq).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let tag = format!("{name} {dofs:?} sparse={sparse}");
+        for step in 0..12 {
+            let (h, t) = (1e-6 * 2f64.powi(step), 0.7 + 0.1 * step as f64);
+            let q: Vec<f64> = start.iter().zip(&dir).map(|(a, d)| a + h * d).collect();
+            k.solve_chord(&q, t).unwrap();
+            full.solve(&q, t).unwrap();
+            full.first_order();
+            full.velocities(&qd);
+            full.accelerations();
+            let f = full.f_xi().subcols(0, nq).to_owned();
+            let fv = &f * &v;
+            let scale = |m: &faer::Mat<f64>| {
+                (0..m.ncols())
+                    .flat_map(|c| m.col_as_slice(c).to_vec())
+                    .fold(0.0f64, |a, b| a.max(b.abs()))
+            };
+            let mut out = faer::Mat::zeros(nx, 3);
+            let v_in = if step % 2 == 0 {
+                v.as_ref()
+            } else {
+                vt.transpose()
+            };
+            if step % 3 == 0 {
+                // a strided destination
+                let mut out_t = faer::Mat::zeros(3, nx);
+                k.transfer_matrix(v_in, out_t.as_mut().transpose_mut())
+                    .unwrap();
+                out.copy_from(out_t.transpose());
+            } else {
+                k.transfer_matrix(v_in, out.as_mut()).unwrap();
+            }
+            let fs = scale(&fv);
+            for c in 0..3 {
+                for i in 0..nx {
+                    let (a, b) = (out[(i, c)], fv[(i, c)]);
+                    assert!(
+                        (a - b).abs() <= 1e-11 * fs,
+                        "{tag} step {step}: F,q V {a} vs {b}"
+                    );
+                }
+            }
+            let fq_qd: Vec<f64> = (0..nx)
+                .map(|i| (0..3).map(|c| out[(i, c)] * zd[c]).sum())
+                .collect();
+            k.velocities_from(&qd, &fq_qd).unwrap();
+            let vs = full.xd().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (a, b) in k.xd().iter().zip(full.xd()) {
+                assert!(
+                    (a - b).abs() <= 1e-11 * vs,
+                    "{tag} step {step}: ẋ {a} vs {b}"
+                );
+            }
+            for (a, b) in k.epsd().iter().zip(full.epsd()) {
+                assert!((a - b).abs() <= 1e-11 * vs.max(1.0), "{tag}: ε̇ {a} vs {b}");
+            }
+            let mut xdd = vec![0.0; nx];
+            k.accelerations_refined(&qdd, &mut xdd).unwrap();
+            let expected: Vec<f64> = (0..nx)
+                .map(|i| full.xdd0()[i] + (0..nq).map(|c| f[(i, c)] * qdd[c]).sum::<f64>())
+                .collect();
+            let xs = expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (a, b) in xdd.iter().zip(&expected) {
+                assert!(
+                    (a - b).abs() <= 1e-10 * xs,
+                    "{tag} step {step}: ẍ {a} vs {b}"
+                );
+            }
+        }
+        // caller errors: the sizes of V, F,q V, q̇, F,q q̇, q̈ and ẍ
+        let mut out = faer::Mat::zeros(nx, 3);
+        let short = faer::Mat::<f64>::zeros(nq - 1, 3);
+        assert!(matches!(
+            k.transfer_matrix(short.as_ref(), out.as_mut()),
+            Err(KinematicsError::Length { .. })
+        ));
+        let mut narrow = faer::Mat::zeros(nx, 2);
+        assert!(matches!(
+            k.transfer_matrix(v.as_ref(), narrow.as_mut()),
+            Err(KinematicsError::Length { .. })
+        ));
+        assert!(k.velocities_from(&qd, &vec![0.0; nx + 1]).is_err());
+        assert!(k
+            .accelerations_refined(&qdd[1..], &mut vec![0.0; nx])
+            .is_err());
+    }
+}
+
 /// A jump the first Newton solve cannot make (it falls back to continuation
 /// from the last solution, restored with its own deformations and element
 /// Jacobians) ends with the configuration and F,ξ of a path of small steps,

@@ -21,13 +21,23 @@
 //! - a solve without a successful factorization sets its right-hand side to
 //!   NaN, so that it can never pass for a result.
 //!
-//! The factorization itself is faer's `lu_in_place` (partial pivoting); the
-//! solves are triangular solves on its factors.
+//! The factorization itself is a plain elimination with partial pivoting
+//! for small matrices ([`UNBLOCKED_UP_TO`]) and faer's `lu_in_place` above;
+//! the solves are triangular solves on the factors.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::factor::{lu_in_place, lu_in_place_scratch};
 use faer::linalg::triangular_solve as tri;
 use faer::{Mat, MatMut, MatRef, Par};
+
+/// Matrices up to this order are factorized by a plain right-looking
+/// elimination (`DenseLu::factor_unblocked`), larger ones by faer's
+/// recursive blocked LU. For the small Jacobians and mass matrices that are
+/// refactorized in every few evaluations faer's blocking and dispatch cost
+/// more than the arithmetic: the 33 × 33 kinematic Jacobian of the spatial
+/// guidance in nodal DOFs took 57 000 instructions with faer (callgrind),
+/// TODO with the plain loop.
+pub const UNBLOCKED_UP_TO: usize = 48;
 
 /// Default pivot ratio min |Uᵢᵢ| / max |Uᵢᵢ| at or below which a matrix is
 /// treated as (numerically) singular.
@@ -187,14 +197,18 @@ impl DenseLu {
             self.factored = true;
             return Ok(1.0);
         }
-        lu_in_place(
-            self.lu.as_mut(),
-            &mut self.fwd,
-            &mut self.bwd,
-            Par::Seq,
-            MemStack::new(&mut self.mem),
-            Default::default(),
-        );
+        if n <= UNBLOCKED_UP_TO {
+            self.factor_unblocked();
+        } else {
+            lu_in_place(
+                self.lu.as_mut(),
+                &mut self.fwd,
+                &mut self.bwd,
+                Par::Seq,
+                MemStack::new(&mut self.mem),
+                Default::default(),
+            );
+        }
         let (mut mn, mut imn, mut mx) = (f64::INFINITY, 0, 0.0f64);
         for i in 0..n {
             let d = self.lu[(i, i)];
@@ -223,6 +237,64 @@ impl DenseLu {
         self.pivot_ratio = ratio;
         self.factored = true;
         Ok(ratio)
+    }
+
+    /// Right-looking elimination with partial pivoting in place, column by
+    /// column (each update a contiguous axpy), with the row exchanges in
+    /// `fwd` and `bwd` as faer's `lu_in_place` gives them. A zero pivot
+    /// column is left as it is (the pivot check then refuses the factor).
+    fn factor_unblocked(&mut self) {
+        let n = self.n;
+        for (i, (f, b)) in self.fwd.iter_mut().zip(&mut self.bwd).enumerate() {
+            (*f, *b) = (i, i);
+        }
+        for k in 0..n {
+            let col = self.lu.col_as_slice(k);
+            let mut p = k;
+            let mut best = col[k].abs();
+            for (i, v) in col.iter().enumerate().skip(k + 1) {
+                if v.abs() > best {
+                    (p, best) = (i, v.abs());
+                }
+            }
+            if p != k {
+                self.fwd.swap(k, p);
+                for j in 0..n {
+                    let c = self.lu.col_as_slice_mut(j);
+                    c.swap(k, p);
+                }
+            }
+            let pivot = self.lu[(k, k)];
+            if pivot == 0.0 {
+                continue;
+            }
+            let inv = 1.0 / pivot;
+            for l in &mut self.lu.col_as_slice_mut(k)[k + 1..] {
+                *l *= inv;
+            }
+            // the trailing columns minus the multipliers times row k
+            let (left, right) = self.lu.as_mut().split_at_col_mut(k + 1);
+            let l = &left
+                .col_mut(k)
+                .try_as_col_major_mut()
+                .expect("column-major")
+                .as_slice_mut()[k + 1..];
+            for col in right.col_iter_mut() {
+                let c = col
+                    .try_as_col_major_mut()
+                    .expect("column-major")
+                    .as_slice_mut();
+                let ukj = c[k];
+                if ukj != 0.0 {
+                    for (d, li) in c[k + 1..].iter_mut().zip(l) {
+                        *d -= li * ukj;
+                    }
+                }
+            }
+        }
+        for (i, f) in self.fwd.iter().enumerate() {
+            self.bwd[*f] = i;
+        }
     }
 
     /// False (and B set to NaN) when there is nothing to solve with.
@@ -420,7 +492,8 @@ mod tests {
             ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
         };
         let mut lu = DenseLu::default();
-        for n in [2usize, 8, 31, 77, 80] {
+        // both sides of UNBLOCKED_UP_TO
+        for n in [2usize, 8, 31, 48, 49, 77, 80] {
             let a = Mat::from_fn(n, n, |i, j| if i == j { 1e-3 * rnd() } else { rnd() });
             lu.factor(a.as_ref()).unwrap();
             let b: Vec<f64> = (0..n).map(|_| rnd()).collect();

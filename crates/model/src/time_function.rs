@@ -75,6 +75,20 @@ pub enum TimeFunction {
         /// Values.
         v: Vec<f64>,
     },
+    /// A piecewise cubic Hermite curve through values and rates at the
+    /// times `t`: on [t_i, t_i+1] the cubic with value and rate `value[i]`,
+    /// `rate[i]` at t_i and `value[i+1]`, `rate[i+1]` at t_i+1, in the local
+    /// time t − t_i (well conditioned for short pieces, unlike
+    /// `PiecewisePolynomial`'s absolute time). C¹; constant at the end
+    /// values outside [t_0, t_n] (rate and acceleration zero there).
+    Hermite {
+        /// Times, increasing (at least two).
+        t: Vec<f64>,
+        /// Values at them.
+        value: Vec<f64>,
+        /// Rates at them.
+        rate: Vec<f64>,
+    },
     /// A scaled copy: `scale` × `f`.
     Scaled {
         /// Factor.
@@ -203,6 +217,22 @@ impl TimeFunction {
                 let s = (v[i + 1] - v[i]) / (ts[i + 1] - ts[i]);
                 (v[i] + s * (t - ts[i]), s, 0.0)
             }
+            TimeFunction::Hermite { t: ts, value, rate } => {
+                let n = ts.len();
+                if t <= ts[0] {
+                    return (value[0], 0.0, 0.0);
+                }
+                if t >= ts[n - 1] {
+                    return (value[n - 1], 0.0, 0.0);
+                }
+                let i = ts.partition_point(|x| *x <= t) - 1;
+                hermite_piece(
+                    ts[i + 1] - ts[i],
+                    [value[i], rate[i]],
+                    [value[i + 1], rate[i + 1]],
+                    t - ts[i],
+                )
+            }
             TimeFunction::Scaled { scale, f } => {
                 let (a, b, c) = f.eval(t);
                 (scale * a, scale * b, scale * c)
@@ -313,6 +343,33 @@ impl TimeFunction {
                 }
                 Ok(())
             }
+            TimeFunction::Hermite { t, value, rate } => {
+                if t.len() < 2 || value.len() != t.len() || rate.len() != t.len() {
+                    return Err(format!(
+                        "Hermite needs at least two times and as many values and rates, got {}, {} and {}",
+                        t.len(),
+                        value.len(),
+                        rate.len()
+                    ));
+                }
+                if let Some(i) = t
+                    .windows(2)
+                    .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+                {
+                    return Err(format!(
+                        "Hermite times must increase: t[{}] = {} is followed by {}",
+                        i,
+                        t[i],
+                        t[i + 1]
+                    ));
+                }
+                for (name, v) in [("t", t), ("value", value), ("rate", rate)] {
+                    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                        return Err(format!("Hermite {name}[{i}] is {}", v[i]));
+                    }
+                }
+                Ok(())
+            }
             TimeFunction::Scaled { scale, f } => {
                 fin("scale", *scale)?;
                 f.validate()
@@ -320,6 +377,19 @@ impl TimeFunction {
             TimeFunction::Sum(fs) => fs.iter().try_for_each(|f| f.validate()),
         }
     }
+}
+
+/// The cubic on a piece of length `h` with value and rate `a` at its start
+/// and `b` at its end, and its first two derivatives, at the local time τ.
+fn hermite_piece(h: f64, a: [f64; 2], b: [f64; 2], tau: f64) -> (f64, f64, f64) {
+    // p = a0 + a1 τ + c2 τ² + c3 τ³
+    let c2 = (3.0 * (b[0] - a[0]) / h - 2.0 * a[1] - b[1]) / h;
+    let c3 = (2.0 * (a[0] - b[0]) / h + a[1] + b[1]) / (h * h);
+    (
+        a[0] + tau * (a[1] + tau * (c2 + tau * c3)),
+        a[1] + tau * (2.0 * c2 + 3.0 * tau * c3),
+        2.0 * c2 + 6.0 * tau * c3,
+    )
 }
 
 #[cfg(test)]
@@ -374,6 +444,40 @@ mod tests {
             },
             &[0.1, 0.2, 0.4, 0.55],
         );
+    }
+
+    /// Pieces of 1 ms late in a run (the chapter-7 angle references): the
+    /// ends' values and rates to rounding, derivatives against differences,
+    /// C¹ across the knots; outside the times the end values.
+    #[test]
+    fn hermite_pieces_keep_their_end_values_and_rates() {
+        let t = vec![1.2, 1.201, 1.202];
+        let f = TimeFunction::Hermite {
+            t: t.clone(),
+            value: vec![0.3, 0.298, 0.2961],
+            rate: vec![-2.0, -1.9, -1.85],
+        };
+        f.validate().unwrap();
+        let (v0, d0, _) = f.eval(1.2 + 1e-15);
+        assert!((v0 - 0.3).abs() < 1e-14 && (d0 + 2.0).abs() < 1e-9);
+        for (k, (v, r)) in [(0.298, -1.9), (0.2961, -1.85)].into_iter().enumerate() {
+            let knot = t[k + 1];
+            let (l, dl, _) = f.eval(knot - 1e-13);
+            let (a, da, _) = f.eval(knot);
+            assert!(
+                (a - v).abs() < 1e-14 && (l - v).abs() < 1e-12,
+                "{k}: {l} {a} {v}"
+            );
+            if k == 0 {
+                assert!(
+                    (da - r).abs() < 1e-9 && (dl - r).abs() < 1e-7,
+                    "{k}: {dl} {da} {r}"
+                );
+            }
+        }
+        check_derivatives(&f, &[1.2003, 1.2017]);
+        assert_eq!(f.eval(1.0), (0.3, 0.0, 0.0));
+        assert_eq!(f.eval(2.0), (0.2961, 0.0, 0.0));
     }
 
     #[test]
@@ -431,5 +535,13 @@ mod tests {
         .validate()
         .is_err());
         assert!(TimeFunction::Constant(f64::NAN).validate().is_err());
+        let hermite = |t: Vec<f64>, value: Vec<f64>, rate: Vec<f64>| {
+            TimeFunction::Hermite { t, value, rate }
+                .validate()
+                .unwrap_err()
+        };
+        assert!(hermite(vec![0.0, 1.0], vec![0.0], vec![0.0, 0.0]).contains("as many values"));
+        assert!(hermite(vec![0.0, 0.0], vec![0.0; 2], vec![0.0; 2]).contains("t[0] = 0"));
+        assert!(hermite(vec![0.0, 1.0], vec![0.0, f64::NAN], vec![0.0; 2]).contains("value[1]"));
     }
 }

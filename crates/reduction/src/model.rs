@@ -16,12 +16,13 @@ pub struct ReducedModel {
     qd: Vec<f64>,
     gz: Mat<f64>,
     conv: Vec<f64>,
-    /// Work space of the equations of motion (no allocation per evaluation
-    /// here; the Cholesky factor of Mz is the one allocation left).
+    /// Work space of the equations of motion (no allocation per
+    /// evaluation): Mz and its Cholesky factor in place with the factor's
+    /// scratch memory, and the full-mass reference's G,zᵀ rhs and Mq G,z.
+    mz: Mat<f64>,
+    llt_mem: faer::dyn_stack::MemBuffer,
     r: Vec<f64>,
     mg: Mat<f64>,
-    mz: Mat<f64>,
-    fz: Mat<f64>,
     /// The chart checks of a running simulation.
     watch: ChartWatch,
 }
@@ -57,7 +58,20 @@ impl ReducedModel {
             r: vec![0.0; nq],
             mg: Mat::zeros(nq, nz),
             mz: Mat::zeros(nz, nz),
-            fz: Mat::zeros(nz, 1),
+            llt_mem: faer::dyn_stack::MemBuffer::new(
+                faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
+                    nz,
+                    faer::Par::Seq,
+                    Default::default(),
+                )
+                .or(
+                    faer::linalg::cholesky::llt::solve::solve_in_place_scratch::<f64>(
+                        nz,
+                        1,
+                        faer::Par::Seq,
+                    ),
+                ),
+            ),
             watch: ChartWatch::default(),
             basis,
         })
@@ -164,7 +178,19 @@ impl ReducedModel {
         Ok((0..nz).map(|k| b[(k, 0)]).collect())
     }
 
-    /// z̈ from (6.15): Mz z̈ = G,zᵀ(rhs_q − Mq (G,zz ż)ż), Mz = G,zᵀ Mq G,z.
+    /// z̈ from the reduced equations of motion (6.15):
+    /// Mz z̈ = G,zᵀ(F,qᵀ(f − Mx ẍ0 − h) − E,qᵀσ − Mq (G,zz ż)ż),
+    /// Mz = G,zᵀ Mq G,z, at q = G(z), q̇ = G,z ż.
+    ///
+    /// Evaluated with the reduced transfer matrix F,z = F,q G,z (n_z solves
+    /// with the kinematic Jacobian) as Mz = F,zᵀ Mx F,z by element blocks
+    /// and the right-hand side F,zᵀ(f − Mx ẍ_c − h) − E,zᵀσ with
+    /// ẍ_c = ẍ0 + F,q (G,zz ż)ż from one more solve
+    /// ([`Dynamics::projected_mass_and_force`]): no n_q × n_q matrix, and
+    /// no allocation per evaluation. The cost grows with n_z (besides the
+    /// element loops and the position solve over the whole mechanism), not
+    /// with n_q. [`accelerations_from_full_mass`](Self::accelerations_from_full_mass)
+    /// gives the same z̈ from the unreduced Mq.
     pub fn accelerations(
         &mut self,
         t: f64,
@@ -172,13 +198,30 @@ impl ReducedModel {
         zd: &[f64],
         zdd: &mut [f64],
     ) -> Result<(), ReductionError> {
-        self.check_reduced(&[("z", z.len()), ("ż", zd.len()), ("z̈", zdd.len())])?;
-        let nz = self.basis.n_z();
-        self.basis
-            .eval(z, zd, &mut self.q, &mut self.gz, &mut self.conv);
-        for (i, v) in self.qd.iter_mut().enumerate() {
-            *v = (0..nz).map(|k| self.gz[(i, k)] * zd[k]).sum();
-        }
+        self.full_motion_at(z, zd, zdd)?;
+        let (mz, rhs) =
+            self.dy
+                .projected_mass_and_force(t, &self.q, self.gz.as_ref(), zd, &self.conv)?;
+        self.mz.copy_from(mz);
+        zdd.copy_from_slice(rhs);
+        self.solve_reduced_mass(zdd)
+    }
+
+    /// z̈ of (6.15) as the unreduced model's pieces give it: Mq and the
+    /// generalized force of (D.10) at q = G(z), q̇ = G,z ż
+    /// ([`Dynamics::mass_and_force`], n_q + n_u solves for F,ξ and
+    /// O(n_x n_q²) for Mq), projected: Mz = G,zᵀ Mq G,z and
+    /// G,zᵀ(rhs_q − Mq (G,zz ż)ż). The reference that
+    /// [`accelerations`](Self::accelerations) is tested against; it does not
+    /// count an evaluation of the reduced model but one of the unreduced.
+    pub fn accelerations_from_full_mass(
+        &mut self,
+        t: f64,
+        z: &[f64],
+        zd: &[f64],
+        zdd: &mut [f64],
+    ) -> Result<(), ReductionError> {
+        self.full_motion_at(z, zd, zdd)?;
         let (mq, rhs) = self.dy.mass_and_force(t, &self.q, &self.qd)?;
         let (r, gz, conv) = (&mut self.r, &self.gz, &self.conv);
         r.copy_from_slice(rhs);
@@ -204,22 +247,50 @@ impl ReducedModel {
             1.0,
             faer::Par::Seq,
         );
-        for k in 0..nz {
-            self.fz[(k, 0)] = gz
+        for (k, v) in zdd.iter_mut().enumerate() {
+            *v = gz
                 .col_as_slice(k)
                 .iter()
                 .zip(r.iter())
                 .map(|(g, v)| g * v)
                 .sum();
         }
-        let llt = self
-            .mz
-            .llt(faer::Side::Lower)
-            .map_err(|_| ReductionError::SingularMass)?;
-        llt.solve_in_place(self.fz.as_mut());
-        for (k, v) in zdd.iter_mut().enumerate() {
-            *v = self.fz[(k, 0)];
+        self.solve_reduced_mass(zdd)
+    }
+
+    /// Checks the lengths of z, ż and z̈ and evaluates the basis there:
+    /// q = G(z), G,z, (G,zz ż)ż and q̇ = G,z ż in the model's buffers.
+    fn full_motion_at(&mut self, z: &[f64], zd: &[f64], zdd: &[f64]) -> Result<(), ReductionError> {
+        self.check_reduced(&[("z", z.len()), ("ż", zd.len()), ("z̈", zdd.len())])?;
+        self.basis
+            .eval(z, zd, &mut self.q, &mut self.gz, &mut self.conv);
+        for (i, v) in self.qd.iter_mut().enumerate() {
+            *v = (0..zd.len()).map(|k| self.gz[(i, k)] * zd[k]).sum();
         }
+        Ok(())
+    }
+
+    /// Solves Mz z̈ = b in place (b given in `zdd`) with the Cholesky factor
+    /// of the lower triangle of `self.mz`, factorized in place in
+    /// preallocated memory.
+    fn solve_reduced_mass(&mut self, zdd: &mut [f64]) -> Result<(), ReductionError> {
+        use faer::dyn_stack::MemStack;
+        use faer::linalg::cholesky::llt;
+        let n = zdd.len();
+        llt::factor::cholesky_in_place(
+            self.mz.as_mut(),
+            Default::default(),
+            faer::Par::Seq,
+            MemStack::new(&mut self.llt_mem),
+            Default::default(),
+        )
+        .map_err(|_| ReductionError::SingularMass)?;
+        llt::solve::solve_in_place(
+            self.mz.as_ref(),
+            faer::MatMut::from_column_major_slice_mut(zdd, n, 1),
+            faer::Par::Seq,
+            MemStack::new(&mut self.llt_mem),
+        );
         Ok(())
     }
 }

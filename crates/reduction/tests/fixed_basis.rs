@@ -74,7 +74,16 @@ fn identity_basis_reproduces_the_unreduced_trajectory_and_frequencies() {
     let sol = Dopri5::new(o)
         .solve(&mut red, 0.0, &vec![0.0; 2 * n], 0.2, &Output::Times(times))
         .unwrap();
-    assert_eq!(sol.stats.rhs_evals, full.stats.rhs_evals, "the same steps");
+    // The reduced path evaluates (6.15) by other products than the
+    // unreduced one (F,z Mz by element blocks, issue 18), so the two round
+    // differently and the step-size control may take a few other steps
+    // (measured: 72876 against 72834); the trajectories still agree far
+    // below the integration tolerance (measured 2.8e-14 of 9.4e-3).
+    let (a, b) = (sol.stats.rhs_evals as f64, full.stats.rhs_evals as f64);
+    assert!(
+        (a / b - 1.0).abs() <= 1e-3,
+        "the same steps: {a} against {b}"
+    );
     let mut worst = 0.0f64;
     let mut scale = 0.0f64;
     assert_eq!(sol.len(), full.len());
@@ -87,7 +96,7 @@ fn identity_basis_reproduces_the_unreduced_trajectory_and_frequencies() {
         }
     }
     assert!(
-        worst <= 1e-12 * scale.max(1e-6),
+        worst <= 1e-10 * scale.max(1e-6),
         "trajectories differ by {worst:e}"
     );
     let f_full = undamped_modes(

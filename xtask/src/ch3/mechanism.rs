@@ -395,23 +395,12 @@ pub struct SolidPoint {
 /// phi_deg, z7, mode, f_Hz`), sorted by ϕ.
 pub fn read_solid(path: &Path) -> Result<Vec<SolidPoint>, String> {
     let cols = ["gravity", "phi_set", "M", "phi_deg", "z7"];
-    let read = |key| crate::solid6::read_solid_keyed(path, "solid", &cols, key);
-    let (by_phi, by_m, by_z) = (read(1)?, read(2)?, read(4)?);
-    if by_phi.points.len() != by_m.points.len() || by_phi.points.len() != by_z.points.len() {
-        return Err(format!(
-            "{}: the decks' columns do not pair up",
-            path.display()
-        ));
-    }
-    let mut v: Vec<SolidPoint> = by_phi
-        .points
+    let mut v: Vec<SolidPoint> = crate::solid6::read_solid_points(path, &cols)?
         .into_iter()
-        .zip(by_m.points)
-        .zip(by_z.points)
-        .map(|(((phi, freqs), (moment, _)), (z7, _))| SolidPoint {
-            phi,
-            moment,
-            z7,
+        .map(|(c, freqs)| SolidPoint {
+            phi: c[1],
+            moment: c[2],
+            z7: c[4],
             freqs,
         })
         .collect();

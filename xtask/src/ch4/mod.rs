@@ -5,6 +5,7 @@
 //! `fixtures/scenes/two_dof_mechanism.ron` with the part files in
 //! `fixtures/scenes/two_dof_mechanism/` by `cargo xtask mechanism4`.
 
+pub mod hinge_check;
 pub mod layout;
 pub mod parts;
 pub mod path;

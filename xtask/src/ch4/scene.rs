@@ -265,7 +265,7 @@ fn sheet_section(kind: HingeKind, height_tag: &str) -> String {
 }
 
 /// Adds the sections every hinge kind needs.
-fn hinge_sections(st: &mut SceneText) {
+pub fn hinge_sections(st: &mut SceneText) {
     for kind in [
         HingeKind::Base,
         HingeKind::ElbowX,

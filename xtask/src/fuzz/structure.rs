@@ -137,9 +137,9 @@ fn select(s: &Scene, rng: &mut Rng) -> Select {
 /// A time function, at most `depth` levels of `Scaled`/`Sum` deep.
 pub fn time_function(rng: &mut Rng, depth: usize) -> TimeFunction {
     let k = if depth == 0 {
-        rng.below(8)
+        rng.below(9)
     } else {
-        rng.below(10)
+        rng.below(11)
     };
     match k {
         0 => TimeFunction::Constant(some_number(rng)),
@@ -191,7 +191,17 @@ pub fn time_function(rng: &mut Rng, depth: usize) -> TimeFunction {
                 v: (0..m).map(|_| some_number(rng)).collect(),
             }
         }
-        8 => TimeFunction::Scaled {
+        8 => {
+            let n = rng.below(5);
+            let len = |rng: &mut Rng| if rng.chance(0.8) { n } else { rng.below(5) };
+            let (nv, nr) = (len(rng), len(rng));
+            TimeFunction::Hermite {
+                t: (0..n).map(|i| number(rng, i as f64)).collect(),
+                value: (0..nv).map(|_| some_number(rng)).collect(),
+                rate: (0..nr).map(|_| some_number(rng)).collect(),
+            }
+        }
+        9 => TimeFunction::Scaled {
             scale: some_number(rng),
             f: Box::new(time_function(rng, depth - 1)),
         },
@@ -301,6 +311,19 @@ fn mutate_function(f: &mut TimeFunction, rng: &mut Rng) {
                 }
             }
         },
+        TimeFunction::Hermite { t, value, rate } => {
+            let v = match rng.below(3) {
+                0 => t,
+                1 => value,
+                _ => rate,
+            };
+            if v.is_empty() || rng.chance(0.2) {
+                v.pop();
+            } else {
+                let i = rng.below(v.len());
+                v[i] = number(rng, v[i]);
+            }
+        }
         TimeFunction::Scaled { scale, f } => {
             if rng.chance(0.5) {
                 *scale = number(rng, *scale)

@@ -177,6 +177,7 @@ pub const VOCABULARY: &[&str] = &[
     "Sine",
     "SkewSineMoves",
     "PiecewisePolynomial",
+    "Hermite",
     "Table",
     "Scaled",
     "Sum",
