@@ -39,6 +39,9 @@ pub fn simulation_options(t_end: f64, dt: f64, rtol: f64) -> SimulationOptions {
     SimulationOptions {
         rtol,
         atol: rtol * 1e-3,
+        // Adams takes about 10⁶ steps for 0.3 s (the flexures' stiff
+        // in-plane modes set the step): the default cap is too close
+        max_steps: 4_000_000,
         ..SimulationOptions::new(Integrator::Adams, 0.0, t_end, n + 1)
     }
 }
