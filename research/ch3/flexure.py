@@ -19,9 +19,11 @@ Usage: python3 flexure.py --ms 0.1,0.2,0.3,0.4 --nl 20 --nh 20 --nt 2 --out DIR
 (the moments listed and their negatives, and M = 0)
 Prints CSV: case,M,phi_deg,mode,f_Hz (phi: the rotation node's U2, in degrees)
 """
-import argparse, math, os, subprocess, sys
+import argparse, math, os, sys
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../sheet22"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from sheet import mesh
+import deck
 
 L, H, T = 0.04, 0.04, 3e-4
 E, NU, RHO = 2.1e11, 0.3125, 7800.0
@@ -67,31 +69,19 @@ def write(path, a, m):
 
 
 def parse(path):
-    """Rotation-node U2 of each static step and the frequencies of each
-    perturbation step, in order."""
-    rots, freqs = [], []
-    lines = open(path).read().splitlines()
-    i = 0
+    """Rotation-node U2 of each static step (its last increment before the
+    step's eigenvalue output) and the frequencies of each perturbation step,
+    in order."""
+    rots = []
     last = None
-    while i < len(lines):
-        l = lines[i]
+    lines = open(path).read().splitlines()
+    for i, l in enumerate(lines):
         if l.strip().startswith("displacements (vx,vy,vz) for set ROTN"):
             v = [s for s in lines[i + 1:i + 4] if s.strip()][0].split()
             last = float(v[2])
         elif "E I G E N V A L U E   O U T P U T" in l:
             rots.append(last)
-            fs = []
-            j = i + 1
-            while j < len(lines) and "P A R T I C I P" not in lines[j] and "E I G E N V A L U E    N U M B E R" not in lines[j]:
-                v = lines[j].split()
-                if len(v) == 5 and v[0].isdigit():
-                    fs.append(float(v[3]))
-                j += 1
-            freqs.append(fs)
-            i = j
-            continue
-        i += 1
-    return rots, freqs
+    return rots, deck.parse_frequencies(path)
 
 
 def main():
@@ -115,12 +105,7 @@ def main():
         nn, ne = write(os.path.join(a.out, job + ".inp"), a, m if m != 0.0 else 1e-12)
         print(f"# {job}: {nn} nodes, {ne} elements", file=sys.stderr)
         if not a.reuse:
-            env = dict(os.environ, OMP_NUM_THREADS="1")
-            r = subprocess.run(["nice", "-n", "10", "ccx", "-i", job], cwd=a.out, env=env,
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-            open(os.path.join(a.out, job + ".log"), "w").write(r.stdout)
-            if "Job finished" not in r.stdout:
-                raise SystemExit(f"ccx failed, see {a.out}/{job}.log")
+            deck.run_ccx(job, a.out)
         rots, freqs = parse(os.path.join(a.out, job + ".dat"))
         if len(rots) != 1:
             raise SystemExit(f"{job}: {len(rots)} perturbation steps parsed, 1 expected")

@@ -19,6 +19,10 @@
 //! thickness along z; the link from (0.04, 0, 0) to (0.29, 0, 0) and then
 //! to the mass at (0.29, 0, −0.1); the moment about y at the flexure's end.
 
+pub mod component;
+pub mod mechanism;
+pub mod response;
+
 use crate::curves::StoredCurve;
 use crate::models::{quasi_static_curve_of, CurvePoint, Model, ModelKind};
 use crate::progress::Progress;
@@ -195,18 +199,19 @@ pub fn scene(kind: Kind, file: &str) -> String {
     )
 }
 
-/// The rotation ϕ (degrees) of the flexure's end about y, from its Euler
-/// parameters in x: ϕ = 2 atan2(λ2, λ0) for a turn about y (thesis (2.3)
-/// conventions, λ = (λ0, λ1, λ2, λ3)).
-fn end_rotation(
-    mech: &Arc<flexmb_model::Mechanism>,
-) -> Result<impl Fn(&[f64]) -> Vec<f64>, String> {
-    let node = format!("N{SEGMENTS}");
+/// The rotation (degrees) of `node` about the global axis `axis` (0, 1, 2
+/// for x, y, z), from its Euler parameters in x: 2 atan2(λ_axis+1, λ0) for a
+/// turn about that axis (thesis (2.3) conventions, λ = (λ0, λ1, λ2, λ3)).
+pub fn rotation_about(
+    mech: &flexmb_model::Mechanism,
+    node: &str,
+    axis: usize,
+) -> Result<impl Fn(&[f64]) -> f64 + Send + Sync + 'static, String> {
     let o = mech
-        .node(&node)
+        .node(node)
         .and_then(|n| n.orientation.clone())
         .ok_or_else(|| format!("node {node} has no orientation coordinates"))?;
-    Ok(move |x: &[f64]| vec![(2.0 * x[o[2]].atan2(x[o[0]])).to_degrees()])
+    Ok(move |x: &[f64]| (2.0 * x[o[axis + 1]].atan2(x[o[0]])).to_degrees())
 }
 
 /// The curve of one model: ϕ and f1 … f4 along the moments.
@@ -216,18 +221,30 @@ pub fn curve(
     file: &str,
     n_moments: usize,
 ) -> Result<Vec<CurvePoint>, String> {
+    let lambdas: Vec<f64> = (0..n_moments)
+        .map(|i| -1.0 + 2.0 * i as f64 / (n_moments - 1) as f64)
+        .collect();
+    curve_at(kind, dir, file, &lambdas, N_FREQ)
+}
+
+/// ϕ and the first `count` eigenfrequencies of one model at the moments
+/// `lambdas` × [`M_MAX`] (continuation from M = 0).
+pub fn curve_at(
+    kind: Kind,
+    dir: &Path,
+    file: &str,
+    lambdas: &[f64],
+    count: usize,
+) -> Result<Vec<CurvePoint>, String> {
     let text = scene(kind, file);
     let s = Scene::from_ron_str(&text).map_err(|e| format!("{}: {e}", kind.label()))?;
     let mech = Arc::new(
         s.build(Some(dir))
             .map_err(|e| format!("{}: {e}", kind.label()))?,
     );
-    let phi = end_rotation(&mech)?;
+    let phi = rotation_about(&mech, &format!("N{SEGMENTS}"), 1)?;
     let model = Model::new(kind.label(), &mech, ModelKind::Unreduced);
-    let lambdas: Vec<f64> = (0..n_moments)
-        .map(|i| -1.0 + 2.0 * i as f64 / (n_moments - 1) as f64)
-        .collect();
-    quasi_static_curve_of(&model, 0.0, &lambdas, N_FREQ, &phi)
+    quasi_static_curve_of(&model, 0.0, lambdas, count, &|x| vec![phi(x)])
 }
 
 /// Each model's curve.
@@ -240,6 +257,16 @@ pub fn compute(
     o: &Ch3Options,
     pg: &Progress,
 ) -> Result<(Curves, Vec<Segment>), String> {
+    compute_timed(dir, o, pg).map(|(c, s, _)| (c, s))
+}
+
+/// [`compute`] with each curve's wall time (s), in the order of [`Kind::ALL`]
+/// (the three sweeps run in parallel).
+pub fn compute_timed(
+    dir: &Path,
+    o: &Ch3Options,
+    pg: &Progress,
+) -> Result<(Curves, Vec<Segment>, Vec<f64>), String> {
     let bar = pg.bar("ch3: superelements", 2);
     let segments: Result<Vec<Segment>, String> = [false, true]
         .par_iter()
@@ -255,18 +282,41 @@ pub fn compute(
     let curves: Result<Vec<_>, String> = Kind::ALL
         .par_iter()
         .map(|k| {
-            let file = match k {
-                Kind::Nlb => "",
-                Kind::SeC => &segments[0].file,
-                Kind::SeCw => &segments[1].file,
-            };
-            let c = curve(*k, dir, file, o.n_moments).map(|c| (*k, c));
+            let start = std::time::Instant::now();
+            let c = curve(*k, dir, segment_file(*k, &segments), o.n_moments)
+                .map(|c| ((*k, c), start.elapsed().as_secs_f64()));
             bar.inc();
             c
         })
         .collect();
     bar.finish();
-    Ok((curves?, segments))
+    let (curves, seconds) = curves?.into_iter().unzip();
+    Ok((curves, segments, seconds))
+}
+
+/// The superelement file of a model among `segments` (SE-C's, then
+/// SE-CW's); none for the beams.
+pub fn segment_file(kind: Kind, segments: &[Segment]) -> &str {
+    match kind {
+        Kind::Nlb => "",
+        Kind::SeC => &segments[0].file,
+        Kind::SeCw => &segments[1].file,
+    }
+}
+
+/// The moments (N m) of the refined sweep around where modes 4 and 5 meet
+/// (Fig. 3.10b, "around 2 degrees"): −0.04 … 0 N m in steps of 0.0005.
+pub fn veering_moments() -> Vec<f64> {
+    (0..=80).map(|i| -0.04 + 0.0005 * i as f64).collect()
+}
+
+/// The closest approach of modes 4 and 5 along a curve with at least five
+/// frequencies per point: (ϕ, ω4, ω5) where ω5 − ω4 is smallest.
+pub fn closest_approach(c: &[CurvePoint]) -> Option<(f64, f64, f64)> {
+    c.iter()
+        .filter(|p| p.freqs.len() >= 5)
+        .map(|p| (p.position[0], p.freqs[3], p.freqs[4]))
+        .min_by(|a, b| (a.2 - a.1).total_cmp(&(b.2 - b.1)))
 }
 
 /// The stored CalculiX solid reference of the whole flexure
@@ -286,8 +336,13 @@ pub struct SolidPoint {
 
 /// Reads the solid reference, sorted by M.
 pub fn read_solid(root: &Path) -> Result<Vec<SolidPoint>, String> {
-    let p = root.join(SOLID);
-    let mut v: Vec<SolidPoint> = crate::solid6::read_solid_points(&p, &["M", "phi_deg"])?
+    read_solid_file(&root.join(SOLID))
+}
+
+/// Reads a solid of the flexure written by `research/ch3/flexure.py` (rows
+/// `case, M, phi_deg, mode, f_Hz`), sorted by M.
+pub fn read_solid_file(p: &Path) -> Result<Vec<SolidPoint>, String> {
+    let mut v: Vec<SolidPoint> = crate::solid6::read_solid_points(p, &["M", "phi_deg"])?
         .into_iter()
         .map(|(c, freqs)| SolidPoint {
             m: c[0],
@@ -310,26 +365,65 @@ pub fn fixture_dir(root: &Path) -> std::path::PathBuf {
 }
 
 /// Recomputes the stored curves on [`CURVE_MESH`] (superelements built in a
-/// temporary directory).
+/// temporary directory): §3.5.1's three models, §3.5.2's four superelements
+/// (one point each, at rest) and §3.5.3's mechanism along its moments.
 pub fn recompute(root: &Path, pg: &Progress) -> Result<Recomputed, String> {
     let dir = std::env::temp_dir().join(format!("flexmb-ch3-curves-{}", std::process::id()));
     let o = Ch3Options {
         mesh: CURVE_MESH,
         ..Ch3Options::default()
     };
-    let c = compute(&dir, &o, pg);
+    let mo = mechanism::MechOptions {
+        mesh: CURVE_MESH,
+        ..Default::default()
+    };
+    let c = (|| {
+        let (flexure, (comp, flexures)) = rayon::join(
+            || compute(&dir, &o, pg),
+            || {
+                rayon::join(
+                    || component::compute(&dir, &component::Geometry::default(), pg),
+                    || mechanism::build_flexures(&dir, mo.mesh, mo.segments),
+                )
+            },
+        );
+        let ((flexure, _), comp, flexures) = (flexure?, comp?, flexures?);
+        let files = mechanism::Files {
+            segments: mo.segments,
+            flexure_a: flexures[0].file.clone(),
+            flexure_b: flexures[1].file.clone(),
+            component: component::file_of(6),
+        };
+        let sweep = mechanism::sweep(&dir, &files, mo.n_moments)?;
+        Ok::<_, String>((flexure, comp, sweep))
+    })();
     let _ = std::fs::remove_dir_all(&dir);
-    let (c, _) = c?;
+    let (c, comp, sweep) = c?;
+    let mut curves: Vec<StoredCurve> = c
+        .iter()
+        .map(|(k, p)| StoredCurve::from_points(k.label(), p, 0, N_FREQ))
+        .collect();
+    curves.extend(comp.models.iter().map(|m| StoredCurve {
+        model: format!("component {}", m.name),
+        lambda: vec![0.0],
+        x: vec![0.0],
+        freqs: vec![m.freqs.clone()],
+    }));
+    curves.push(StoredCurve::from_points(
+        "mechanism",
+        &sweep,
+        0,
+        mechanism::N_FREQ,
+    ));
     Ok(Recomputed {
         dir: fixture_dir(root),
-        curves: c
-            .iter()
-            .map(|(k, p)| StoredCurve::from_points(k.label(), p, 0, N_FREQ))
-            .collect(),
+        curves,
         provenance: vec![
             format!("produced by `cargo xtask regress --update` (flexmb {})", env!("CARGO_PKG_VERSION")),
-            format!("the short sheet flexure of thesis §3.5.1 (l = h = {L} m, t = {T} m, steel E = 2.1e11, G = 8e10, rho = 7800), 4 beams or 4 superelements, L-shaped massless rigid link with 0.01 kg, moment lambda x {M_MAX} N m about y at the flexure's end, lambda in [-1, 1] ({} points), continuation from lambda = 0", o.n_moments),
-            format!("superelements: a quarter of the flexure, {:?} hexahedra (x, height, thickness); x = the end's rotation phi (degrees); f_k = undamped eigenfrequencies of the rest linearization (E.6) in Hz", CURVE_MESH),
+            format!("NLB, SE-C, SE-CW: the short sheet flexure of thesis §3.5.1 (l = h = {L} m, t = {T} m, steel E = 2.1e11, G = 8e10, rho = 7800), 4 beams or 4 superelements, L-shaped massless rigid link with 0.01 kg, moment lambda x {M_MAX} N m about y at the flexure's end, lambda in [-1, 1] ({} points), continuation from lambda = 0; x = the end's rotation phi (degrees)", o.n_moments),
+            "component SE-C ... SE-CF6: thesis §3.5.2, our designed component (xtask/src/ch3/component.rs, 5 mm hexahedra) clamped at node 5 with 0.01 kg at node 7 on a rigid link, 0/1/2/6 normal modes; one point: all eigenfrequencies at rest".into(),
+            format!("mechanism: thesis §3.5.3 (60 DOF), moment lambda x {} N m about z at node 5, lambda in [-1, 1] ({} points), no gravity; x = node 5's rotation phi about z (degrees)", mechanism::M_MAX, mo.n_moments),
+            format!("flexure superelements: a quarter of the flexure, {:?} hexahedra (along, height, thickness); f_k = undamped eigenfrequencies of the rest linearization (E.6) in Hz", CURVE_MESH),
         ],
     })
 }

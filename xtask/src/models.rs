@@ -172,12 +172,33 @@ pub struct Response {
     pub settings: String,
 }
 
+/// The configuration a simulation starts from, at rest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// The static equilibrium at t0 (loads and gravity at t0).
+    Equilibrium,
+    /// The reference configuration of the scene (undeflected).
+    Reference,
+}
+
 /// Simulates a model from its static equilibrium at t0 (loads and gravity at
 /// t0), at rest. `progress(t)` is called at each output time.
 pub fn simulate(
     model: &Model,
     opts: &SimulationOptions,
     node: &str,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<Response, String> {
+    simulate_from(model, opts, node, Start::Equilibrium, progress)
+}
+
+/// Simulates a model from `start`, at rest; `progress(t)` is called at each
+/// output time.
+pub fn simulate_from(
+    model: &Model,
+    opts: &SimulationOptions,
+    node: &str,
+    start: Start,
     progress: &(dyn Fn(f64) + Sync),
 ) -> Result<Response, String> {
     let ctx = |e: String| format!("{}: {e}", model.name);
@@ -194,13 +215,17 @@ pub fn simulate(
     );
     let probe = NodeProbe::new(&model.mech, node)?;
     let mut m = model.instance()?;
-    // the static equilibrium at t0 under the full loads, from the reference
     m.set_load_scale(1.0);
     let reference = m.reference_coordinates();
-    let start = m
-        .static_equilibrium(t0, &reference, &StaticOptions::default())
-        .map_err(|e| ctx(e.to_string()))?
-        .coordinates;
+    let start = match start {
+        // the static equilibrium at t0 under the full loads, from the reference
+        Start::Equilibrium => {
+            m.static_equilibrium(t0, &reference, &StaticOptions::default())
+                .map_err(|e| ctx(e.to_string()))?
+                .coordinates
+        }
+        Start::Reference => reference,
+    };
     let cd0 = vec![0.0; start.len()];
     let tr = m
         .simulate(t0, &start, &cd0, opts, &mut |t, _, _| {

@@ -122,7 +122,7 @@ pub fn draw(dir: &Path, file: &str, out: &Path, figs: &mut Figures) -> Result<Dr
 /// drawn, and the figures.
 pub fn section(figs: &Figures, drawn: &Drawn) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "## The flexure and its modes\n");
+    let _ = writeln!(s, "### The flexure and its modes, drawn\n");
     let _ = writeln!(s, "Drawn by `flexmb_draw` (as `flexmb draw`): SE-CW at its static equilibrium under M = 0 and ∓{} N m, its four superelements as the outline of their FE mesh recovered from the superelement coordinates (the edges where the boundary faces of the quarter-flexure mesh turn by more than 30°, placed as the VTK output places the mesh), the rigid link as boxes of its 10 × 10 mm section (the whole mechanism, then the flexure alone); then modes 2 and 4 of the rest linearization at each moment, at ±10 % of the mechanism's size (the lighter line is −). The frequencies are those of the curves at these moments.\n", ch3::M_MAX);
     let mut header = vec!["M (N m)".to_string(), "ϕ (°)".into()];
     header.extend(MODES.iter().map(|k| format!("ω{k} (Hz)")));

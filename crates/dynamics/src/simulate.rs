@@ -61,6 +61,9 @@ pub struct SimulationOptions {
     /// with the outputs reached so far and one more output at the step where
     /// it stopped (e.g. set by a signal handler).
     pub stop: Option<Arc<AtomicBool>>,
+    /// The most steps the integrator may take (1 000 000 by default); a
+    /// run that needs more ends with an error naming the time reached.
+    pub max_steps: usize,
 }
 
 impl SimulationOptions {
@@ -82,6 +85,7 @@ impl SimulationOptions {
             atol: 1e-6,
             output_times,
             stop: None,
+            max_steps: 1_000_000,
         }
     }
 }
@@ -306,6 +310,7 @@ fn integrate_explicit_named<S: OdeSystem + ?Sized>(
             let o = Dopri5Options {
                 rtol: opts.rtol,
                 atol: Tolerance::Scalar(opts.atol),
+                max_steps: opts.max_steps,
                 ..Default::default()
             };
             Dopri5::new(o)
@@ -316,6 +321,7 @@ fn integrate_explicit_named<S: OdeSystem + ?Sized>(
             let o = AdamsOptions {
                 rtol: opts.rtol,
                 atol: Tolerance::Scalar(opts.atol),
+                max_steps: opts.max_steps,
                 ..Default::default()
             };
             Adams::new(o)
@@ -897,6 +903,7 @@ impl Dynamics {
                 let o = GeneralizedAlphaOptions {
                     rtol: opts.rtol,
                     atol: Tolerance::Scalar(opts.atol),
+                    max_steps: opts.max_steps,
                     ..Default::default()
                 };
                 // the position solves of the step's iterates read the stop

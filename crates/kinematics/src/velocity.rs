@@ -76,7 +76,7 @@ impl Kinematics {
 
     /// ẋ and ε̇ for q̇ (n_q entries) whose nodal velocity F,q q̇ (n_x
     /// entries) the caller already has, e.g. F,z ż of a reduced model from
-    /// the columns F,z = F,q G,z ([`transfer_times`](Self::transfer_times)):
+    /// the columns F,z = F,q G,z ([`transfer_matrix`](Self::transfer_matrix)):
     /// ẋ = F,q q̇ + F,u u̇(t), the inputs' part by one solve as in
     /// [`velocities_refined`](Self::velocities_refined) (none when no input
     /// moves), and ε̇ from ẋ. The result is that of `velocities_refined(q̇)`

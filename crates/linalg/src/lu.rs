@@ -31,7 +31,7 @@ use faer::linalg::triangular_solve as tri;
 use faer::{Mat, MatMut, MatRef, Par};
 
 /// Matrices up to this order are factorized by a plain right-looking
-/// elimination ([`DenseLu::factor_unblocked`]), larger ones by faer's
+/// elimination (`DenseLu::factor_unblocked`), larger ones by faer's
 /// recursive blocked LU. For the small Jacobians and mass matrices that are
 /// refactorized in every few evaluations faer's blocking and dispatch cost
 /// more than the arithmetic: the 33 × 33 kinematic Jacobian of the spatial

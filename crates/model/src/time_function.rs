@@ -352,7 +352,10 @@ impl TimeFunction {
                         rate.len()
                     ));
                 }
-                if let Some(i) = t.windows(2).position(|w| !(w[1] > w[0])) {
+                if let Some(i) = t
+                    .windows(2)
+                    .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+                {
                     return Err(format!(
                         "Hermite times must increase: t[{}] = {} is followed by {}",
                         i,

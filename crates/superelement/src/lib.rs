@@ -14,7 +14,8 @@
 //!   the full reduced stiffness, the mode shapes, a report).
 //! * [`solid`]: a built-in 20-node hexahedral solid FE and structured mesher,
 //!   [`parts`]: the thesis's parts (prismatic bar, short sheet flexure, unbalanced
-//!   shaft, thin-walled box arm).
+//!   shaft, thin-walled box arm) and [`parts::axis_bar`], a bar along any
+//!   global axis for scenes whose parts do not all run along x.
 //! * [`readers`]: Matrix Market and CalculiX (`.sti`, `.mas`, `.dof`, `.inp`),
 //!   with truncated files and mismatched equation counts named;
 //!   [`consistency`]: the checks of K, M, the DOF list and the mesh against

@@ -33,12 +33,82 @@ impl Part {
     }
 }
 
-fn plane_x(x: f64, scale: f64) -> NodeSelection {
+fn plane_normal(point: [f64; 3], axis: usize, scale: f64) -> NodeSelection {
+    let mut normal = [0.0; 3];
+    normal[axis] = 1.0;
     NodeSelection::NearPlane {
-        point: [x, 0.0, 0.0],
-        normal: [1.0, 0.0, 0.0],
+        point,
+        normal,
         tolerance: 1e-9 * scale,
     }
+}
+
+fn plane_x(x: f64, scale: f64) -> NodeSelection {
+    plane_normal([x, 0.0, 0.0], 0, scale)
+}
+
+/// A prismatic bar from `p` to `q`, which must differ along one global axis
+/// only, with a `by` × `bz` rectangular section centred on the line p–q:
+/// `by` along the global axis `up` (0, 1 or 2 for x, y, z; it becomes the
+/// element y axis) and `bz` along the remaining axis; `n` elements along the
+/// bar, along `up` and along the third axis; interfaces at its end faces.
+/// A part for a scene in which it lies along y or z, or runs along −x: a
+/// superelement keeps the frame it was built in (docs/scene-format.md,
+/// "Placement").
+pub fn axis_bar(
+    p: [f64; 3],
+    q: [f64; 3],
+    up: usize,
+    by: f64,
+    bz: f64,
+    n: [usize; 3],
+    mat: Material,
+) -> Result<Part, Error> {
+    let along: Vec<usize> = (0..3).filter(|&d| p[d] != q[d]).collect();
+    let axis = match along[..] {
+        [a] => a,
+        _ => {
+            return Err(Error::Spec(format!(
+                "a bar from {p:?} to {q:?} must run along one global axis"
+            )))
+        }
+    };
+    if up > 2 || up == axis {
+        return Err(Error::Spec(format!(
+            "the section's axis {up} must be another global axis (0, 1 or 2) than the bar's ({axis})"
+        )));
+    }
+    if n.contains(&0) || !(by > 0.0 && bz > 0.0) {
+        return Err(Error::Spec(format!(
+            "a bar needs positive section sides and element counts, got {by} × {bz} and {n:?}"
+        )));
+    }
+    let third = 3 - axis - up;
+    let len = (q[axis] - p[axis]).abs();
+    let (mut min, mut max, mut h) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+    min[axis] = p[axis].min(q[axis]);
+    max[axis] = p[axis].max(q[axis]);
+    h[axis] = len / n[0] as f64;
+    for (d, b, k) in [(up, by, n[1]), (third, bz, n[2])] {
+        min[d] = p[d] - 0.5 * b;
+        max[d] = p[d] + 0.5 * b;
+        h[d] = b / k as f64;
+    }
+    let mesh = Mesh::boxes(
+        &[Block {
+            min,
+            max,
+            material: 0,
+        }],
+        &[mat],
+        h,
+    )?;
+    let s = len.max(by).max(bz);
+    let mut settings = BuildSettings::new(p, q, plane_normal(p, axis, s), plane_normal(q, axis, s));
+    let mut y = [0.0; 3];
+    y[up] = 1.0;
+    settings.y_axis = Some(y);
+    Ok(Part { mesh, settings })
 }
 
 fn bar_like(
@@ -49,23 +119,7 @@ fn bar_like(
     n: [usize; 3],
     mat: Material,
 ) -> Result<Part, Error> {
-    let mesh = Mesh::boxes(
-        &[Block {
-            min: [x0, -0.5 * by, -0.5 * bz],
-            max: [x0 + len, 0.5 * by, 0.5 * bz],
-            material: 0,
-        }],
-        &[mat],
-        [len / n[0] as f64, by / n[1] as f64, bz / n[2] as f64],
-    )?;
-    let s = len.max(by).max(bz);
-    let settings = BuildSettings::new(
-        [x0, 0.0, 0.0],
-        [x0 + len, 0.0, 0.0],
-        plane_x(x0, s),
-        plane_x(x0 + len, s),
-    );
-    Ok(Part { mesh, settings })
+    axis_bar([x0, 0.0, 0.0], [x0 + len, 0.0, 0.0], 1, by, bz, n, mat)
 }
 
 /// A prismatic bar along x from 0 to `l` with a `by` × `bz` rectangular section
@@ -216,4 +270,70 @@ pub fn unbalanced_shaft_half(
     );
     settings.point_masses.push(tie);
     Ok(Part { mesh, settings })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::build;
+
+    fn steel() -> Material {
+        Material {
+            e: 2.1e11,
+            g: 8e10,
+            rho: 7800.0,
+        }
+    }
+
+    /// A bar along −y with its section's `by` side along z is the bar along
+    /// x turned rigidly: the same S̄ and M̄ in the element frame, warping
+    /// modes included (to rounding: the mesh is a rotated copy and Gauss
+    /// integration does not see the turn), and R0 with x along −y, y along z.
+    #[test]
+    fn a_bar_along_minus_y_is_the_x_bar_turned() {
+        let (l, by, bz, n) = (0.01, 0.04, 3e-4, [2, 4, 1]);
+        let mut x = prismatic_bar(l, by, bz, n, steel()).unwrap();
+        let p = [0.02, 0.02, -0.02];
+        let q = [0.02, 0.02 - l, -0.02];
+        let mut y = axis_bar(p, q, 2, by, bz, n, steel()).unwrap();
+        for s in [&mut x.settings, &mut y.settings] {
+            s.warping_p = true;
+            s.warping_q = true;
+        }
+        let bx = build(&x.mesh.assemble("x").unwrap(), &x.settings).unwrap();
+        let byy = build(&y.mesh.assemble("y").unwrap(), &y.settings).unwrap();
+        let (a, b) = (&bx.data, &byy.data);
+        assert!((a.l0 - b.l0).abs() < 1e-15);
+        let scale = |m: &Vec<Vec<f64>>| m.iter().flatten().fold(0.0f64, |s, v| s.max(v.abs()));
+        for (ma, mb) in [(&a.s_bar, &b.s_bar), (&a.m_bar, &b.m_bar)] {
+            let s = scale(ma);
+            for (ra, rb) in ma.iter().zip(mb) {
+                for (u, v) in ra.iter().zip(rb) {
+                    assert!((u - v).abs() <= 1e-9 * s, "{u} against {v} (scale {s})");
+                }
+            }
+        }
+        // columns of R0: element x, y, z in global axes
+        let col = |r: &[[f64; 3]; 3], j: usize| [r[0][j], r[1][j], r[2][j]];
+        for (j, e) in [[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]]
+            .iter()
+            .enumerate()
+        {
+            let c = col(&b.r0, j);
+            assert!(
+                (0..3).all(|d| (c[d] - e[d]).abs() < 1e-12),
+                "R0 column {j}: {c:?}, expected {e:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_bar_off_the_axes_or_with_a_bad_section_axis_is_refused() {
+        let e = axis_bar([0.0; 3], [0.1, 0.1, 0.0], 2, 0.01, 0.01, [1, 1, 1], steel());
+        assert!(e.unwrap_err().to_string().contains("one global axis"));
+        let e = axis_bar([0.0; 3], [0.0, 0.1, 0.0], 1, 0.01, 0.01, [1, 1, 1], steel());
+        assert!(e.unwrap_err().to_string().contains("another global axis"));
+        let e = axis_bar([0.0; 3], [0.0, 0.1, 0.0], 0, 0.01, 0.01, [0, 1, 1], steel());
+        assert!(e.unwrap_err().to_string().contains("element counts"));
+    }
 }
