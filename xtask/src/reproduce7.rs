@@ -92,15 +92,22 @@ pub struct Ch7Frequencies {
     /// The equilibria halfway between them (beyond the thesis), empty if
     /// not asked for.
     pub between: Vec<SweepPoint>,
-    /// Per variant: the basis, its wall time (s), and the reduced
-    /// eigenfrequencies at the reference configurations and halfway between.
-    pub reduced: Vec<(
-        Variant,
-        InterpolatedBasis,
-        f64,
-        Vec<Vec<f64>>,
-        Vec<Vec<f64>>,
-    )>,
+    /// IBM-u and IBM-c, in this order.
+    pub reduced: Vec<ReducedVariant>,
+}
+
+/// One reduced model along the path and its eigenfrequencies.
+pub struct ReducedVariant {
+    /// Which one.
+    pub variant: Variant,
+    /// Its interpolated basis.
+    pub basis: InterpolatedBasis,
+    /// The basis's wall time (s).
+    pub seconds: f64,
+    /// Its first eigenfrequencies at the reference configurations.
+    pub at_references: Vec<Vec<f64>>,
+    /// And halfway between them.
+    pub halfway: Vec<Vec<f64>>,
 }
 
 /// The reference configurations, IBM-u and IBM-c, and their eigenfrequencies
@@ -141,7 +148,13 @@ pub fn frequencies(
         pg.println(&format!("{} basis in {basis_seconds:.1} s", v.label()));
         let at = ch7::reduced_frequencies(&mech, &b, &points, dofs, ch7::R)?;
         let mid = ch7::reduced_frequencies(&mech, &b, &between, dofs, ch7::R)?;
-        reduced.push((v, b, basis_seconds, at, mid));
+        reduced.push(ReducedVariant {
+            variant: v,
+            basis: b,
+            seconds: basis_seconds,
+            at_references: at,
+            halfway: mid,
+        });
     }
     Ok(Ch7Frequencies {
         mech,
@@ -178,10 +191,11 @@ pub fn stored_curves(f: &Ch7Frequencies) -> Vec<StoredCurve> {
     let mut out = vec![curve("unreduced", &|i| {
         f.points[i].frequencies_hz[..ch7::R].to_vec()
     })];
-    for (v, _, _, at, _) in &f.reduced {
-        out.push(curve(&v.label().to_lowercase().replace('-', "_"), &|i| {
-            at[i].clone()
-        }));
+    for r in &f.reduced {
+        out.push(curve(
+            &r.variant.label().to_lowercase().replace('-', "_"),
+            &|i| r.at_references[i].clone(),
+        ));
     }
     out
 }
@@ -237,7 +251,7 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
     // bases and their eigenfrequencies
     let freq = frequencies(root, o.n_reference, true, pg)?;
     let mech = freq.mech.clone();
-    let ibm_u = &freq.reduced[0].1;
+    let ibm_u = &freq.reduced[0].basis;
     // 3. the angle references from IBM-u's kinematics with η ≡ 0
     let mut kin_model = ch7::reduced(&mech, ibm_u)?;
     let refs = ch7::angle_references(&mut kin_model, 4 * o.n_reference)?;
@@ -376,9 +390,9 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
 /// halfway between them if `between`.
 pub fn mode_errors(f: &Ch7Frequencies, v: usize, k: usize, between: bool) -> Vec<f64> {
     let (points, reduced) = if between {
-        (&f.between, &f.reduced[v].4)
+        (&f.between, &f.reduced[v].halfway)
     } else {
-        (&f.points, &f.reduced[v].3)
+        (&f.points, &f.reduced[v].at_references)
     };
     points
         .iter()
@@ -412,9 +426,13 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
         for k in modes {
             let u: Vec<f64> = f.points.iter().map(|p| p.frequencies_hz[k]).collect();
             p.push(Series::line(&format!("ω{} unreduced", k + 1), &s, &u));
-            for (v, _, _, at, _) in &f.reduced {
-                let y: Vec<f64> = at.iter().map(|f| f[k]).collect();
-                p.push(Series::dashed(&format!("ω{} {}", k + 1, v.label()), &s, &y));
+            for r in &f.reduced {
+                let y: Vec<f64> = r.at_references.iter().map(|f| f[k]).collect();
+                p.push(Series::dashed(
+                    &format!("ω{} {}", k + 1, r.variant.label()),
+                    &s,
+                    &y,
+                ));
             }
         }
         figs.save(&p, out, stem)?;
@@ -523,11 +541,11 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
         "100".into(),
         format!("{} ({:.1} s)", r.freq.points.len(), r.freq.sweep_seconds),
     ]);
-    for (v, _, secs, _, _) in &r.freq.reduced {
+    for v in &r.freq.reduced {
         t.row(vec![
-            format!("{} basis", v.label()),
+            format!("{} basis", v.variant.label()),
             "–".into(),
-            format!("{secs:.1} s"),
+            format!("{:.1} s", v.seconds),
         ]);
     }
     let _ = writeln!(s, "{}", t.render());
