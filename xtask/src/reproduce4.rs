@@ -186,8 +186,13 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
     let (mech, _) = sweep::mechanism(&fixture_scene(root))?;
     pictures(&mech, &r, out, &mut figs).map_err(io)?;
     let diagnosis = constraint_summary(root)?;
+    // the independent check: one base cross-hinge against its stored
+    // CalculiX solid (also `cargo xtask hinge4`)
+    let hinge = ch4::hinge_check::Comparison::compute(root)?;
+    let hinge_section = hinge.section(&mut figs, out).map_err(io)?;
     let wall = start.elapsed().as_secs_f64();
-    let md = report(&o, &r, &figs, &diagnosis, wall);
+    let mut md = report(&o, &r, &figs, &diagnosis, wall);
+    md += &hinge_section;
     std::fs::write(out.join("report.md"), md).map_err(io)
 }
 

@@ -381,6 +381,7 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
     let r = compute(root, &o, pg)?;
     let mut figs = Figures::default();
     figures(&r, out, &mut figs).map_err(io)?;
+    pictures(&r.freq, out, &mut figs).map_err(io)?;
     let md = report(&o, &r, &figs, start.elapsed().as_secs_f64());
     std::fs::write(out.join("report.md"), md).map_err(io)
 }
@@ -409,6 +410,62 @@ pub fn median_and_max(e: &[f64]) -> (f64, f64) {
         e.get(e.len() / 2).copied().unwrap_or(f64::NAN),
         e.last().copied().unwrap_or(f64::NAN),
     )
+}
+
+/// The mechanism at the reference configuration nearest the third stop
+/// (halfway round the circle) over the undeflected one, and its mode 3
+/// there, which both reduced models keep (issue 23).
+fn pictures(f: &Ch7Frequencies, out: &Path, figs: &mut Figures) -> std::io::Result<()> {
+    use flexmb_draw::{Configuration, DrawOptions, View};
+    let stop = Path4::new().marks()[2];
+    let i = (0..f.points.len())
+        .min_by(|a, b| {
+            (f.points[*a].s - stop)
+                .abs()
+                .total_cmp(&(f.points[*b].s - stop).abs())
+        })
+        .unwrap_or(0);
+    let at = Configuration {
+        mechanism: f.mech.clone(),
+        q: f.points[i].q.clone(),
+        x: f.points[i].x.clone(),
+        t: 0.0,
+        load_scale: 1.0,
+    };
+    crate::pictures::save(
+        figs,
+        out,
+        "mech_stop3",
+        &at,
+        &DrawOptions {
+            view: Some(View::Xy),
+            reference: true,
+            title: Some(format!(
+                "The mechanism at s = {:.4} m (the third stop), the undeflected one lighter",
+                f.points[i].s
+            )),
+            ..Default::default()
+        },
+    )?;
+    crate::pictures::save(
+        figs,
+        out,
+        "mech_mode3_stop3",
+        &at,
+        &DrawOptions {
+            view: Some(View::Iso),
+            mode: Some(3),
+            phases: Some(2),
+            title: Some(format!(
+                "Mode 3 at the third stop ({:.1} Hz; IBM-u {:.1} Hz, IBM-c {:.1} Hz)",
+                f.points[i].frequencies_hz[2],
+                f.reduced[0].at_references[i][2],
+                f.reduced[1].at_references[i][2]
+            )),
+            ..Default::default()
+        },
+    )?;
+    Ok(())
 }
 
 fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()> {
@@ -581,7 +638,8 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
         ]);
     }
     let _ = writeln!(s, "{}", t.render());
-    s += &figs.markdown(|f| f.starts_with("fig7_2") || f.starts_with("fig7_3"));
+    s += &figs
+        .markdown(|f| f.starts_with("fig7_2") || f.starts_with("fig7_3") || f.starts_with("mech_"));
     let _ = writeln!(s, "## Closed-loop poles at s = 0 (Table 7.2)\n\nPD controllers (7.12) with Table 7.1's gains on the actuator hinges, no gravity, the state-space eigenvalues of the linearization:\n");
     let mut t = Table::new(&[
         "mode",

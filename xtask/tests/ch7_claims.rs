@@ -113,3 +113,28 @@ fn the_mechanism_modes_follow_away_from_the_ends_and_the_junction() {
         }
     }
 }
+
+/// `flexmb draw`'s mode at a deflected reference configuration is the
+/// sweep's: its linearization starts the position solve from the
+/// configuration's own nodal coordinates (from the reference it converged
+/// on another branch and drew "mode 3, -3525444 Hz" at the third stop).
+#[test]
+fn a_drawn_mode_at_a_deflected_configuration_is_the_sweeps() {
+    let f = frequencies();
+    let i = f.points.len() * 3 / 5;
+    let at = flexmb_draw::Configuration {
+        mechanism: f.mech.clone(),
+        q: f.points[i].q.clone(),
+        x: f.points[i].x.clone(),
+        t: 0.0,
+        load_scale: 1.0,
+    };
+    let shape = flexmb_draw::mode_shape(&at, 3).unwrap();
+    let sweep = f.points[i].frequencies_hz[2];
+    assert!(
+        (shape.frequency_hz / sweep - 1.0).abs() < 1e-6,
+        "draw {} Hz against the sweep's {sweep} Hz at s = {}",
+        shape.frequency_hz,
+        f.points[i].s
+    );
+}

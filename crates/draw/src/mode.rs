@@ -125,6 +125,10 @@ pub fn mode_shape(at: &Configuration, number: usize) -> Result<ModeShape, DrawEr
     let n = mech.n_dof();
     let mut dy = Dynamics::new(mech.clone());
     dy.set_load_scale(at.load_scale);
+    // from the configuration's own nodal coordinates: from the reference
+    // the position solve of q may converge on another branch (a deflected
+    // chapter-4 mechanism gave "mode 3, -1596987 Hz")
+    dy.kinematics_mut().set_guess(&at.x);
     let lin = dy.linearize_at_rest(at.t, &at.q).map_err(compute)?;
     let modes = flexmb_linearize::undamped_modes(&lin, number).map_err(compute)?;
     let k = number - 1;

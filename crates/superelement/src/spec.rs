@@ -123,6 +123,7 @@ pub enum ModelSource {
 
 /// The FE solver of a [`ModelSource::Mesh`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum FeSolver {
     /// The built-in solid FE ([`crate::solid::SolidMesh::assemble`]; with
     /// CalculiX's quadrature, so the two agree to rounding).
