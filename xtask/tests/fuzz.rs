@@ -135,12 +135,6 @@ fn every_seed_scene_survives_writing_back() {
         let b = flexmb_model::Scene::from_ron_str(&a.to_ron()).unwrap();
         assert_eq!(a, b, "{}", s.name);
         let m = a.build(Some(&harness::base_dir(&root)));
-        if s.name.ends_with("two_dof_skeleton_no_releases.ron") {
-            // over-constrained on purpose (chapter 4's diagnosis)
-            let e = m.err().map(|e| e.to_string()).unwrap_or_default();
-            assert!(e.contains("over"), "{}: {e}", s.name);
-            continue;
-        }
         assert!(m.is_ok(), "{}: {:?}", s.name, m.err());
     }
 }

@@ -188,6 +188,7 @@ fn a_mode_shape_is_the_eigenvector_scaled_to_the_amplitude() {
         let at = Configuration::static_equilibrium(&mech).unwrap();
         // the eigenvector as `flexmb eig --static-first` computes it
         let mut dy = flexmb_dynamics::Dynamics::new(at.mechanism.clone());
+        dy.kinematics_mut().set_guess(&at.x);
         let lin = dy.linearize_at_rest(0.0, &at.q).unwrap();
         let modes = flexmb_linearize::undamped_modes(&lin, k).unwrap();
         let v: Vec<f64> = (0..mech.n_dof())

@@ -37,8 +37,10 @@ pub const SCENE_FILE: &str = "two_dof_mechanism.ron";
 pub const ACTUATED_SCENE_FILE: &str = "two_dof_mechanism_actuated.ron";
 /// The skeleton with the releases (exactly constrained).
 pub const SKELETON_FILE: &str = "two_dof_skeleton.ron";
-/// The skeleton without the releases (nine times over-constrained).
-pub const SKELETON_RIGID_FILE: &str = "two_dof_skeleton_no_releases.ron";
+/// The skeleton without the releases (nine times over-constrained), in
+/// `refused/`, where the scenes that every fixture test must build are
+/// not.
+pub const SKELETON_RIGID_FILE: &str = "refused/two_dof_skeleton_no_releases.ron";
 
 /// Builds every part, writes them and the scenes into `dir` (the scene
 /// directory; parts in `dir/two_dof_mechanism/`), in parallel; `progress`
@@ -102,7 +104,11 @@ pub fn write_model(dir: &Path, progress: &(dyn Fn(&str) + Sync)) -> Result<Vec<P
         .chain(sheet_builds)
         .collect::<Result<_, _>>()?;
     let write = |name: &str, text: String| {
-        std::fs::write(dir.join(name), text).map_err(|e| format!("{name}: {e}"))
+        let path = dir.join(name);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| format!("{name}: {e}"))?;
+        }
+        std::fs::write(path, text).map_err(|e| format!("{name}: {e}"))
     };
     write(SCENE_FILE, scene::full_scene(&layout))?;
     write(ACTUATED_SCENE_FILE, scene::actuated_scene(&layout))?;
