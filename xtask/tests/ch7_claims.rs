@@ -138,3 +138,30 @@ fn a_drawn_mode_at_a_deflected_configuration_is_the_sweeps() {
         f.points[i].s
     );
 }
+
+/// The same linearization without a guess, from the reference
+/// configuration: the branch guard of the position solve continues to the
+/// sweep's configuration or refuses; it never linearizes another branch
+/// (before the guard it drew "mode 3, -3525444 Hz" here).
+#[test]
+fn without_a_guess_the_deflected_linearization_is_the_sweeps_or_an_error() {
+    let f = frequencies();
+    let i = f.points.len() * 3 / 5;
+    let mut dy = flexmb_dynamics::Dynamics::new(f.mech.clone());
+    match dy.linearize_at_rest(0.0, &f.points[i].q) {
+        Ok(lin) => {
+            let modes = flexmb_linearize::undamped_modes(&lin, 3).unwrap();
+            let (got, sweep) = (modes.frequencies_hz()[2], f.points[i].frequencies_hz[2]);
+            eprintln!("from the reference: mode 3 {got} Hz, the sweep's {sweep} Hz");
+            assert!(
+                (got / sweep - 1.0).abs() < 1e-6,
+                "{got} Hz against the sweep's {sweep} Hz at s = {}",
+                f.points[i].s
+            );
+        }
+        Err(e) => {
+            eprintln!("from the reference: refused ({e})");
+            assert!(e.to_string().contains("another branch"), "{e}")
+        }
+    }
+}

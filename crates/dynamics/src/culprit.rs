@@ -207,6 +207,49 @@ mod tests {
     use crate::Dynamics;
     use std::sync::Arc;
 
+    /// Near a straightened toggle a stall is explained by the kinematics:
+    /// two rigid bars of 1 m, the free end C on the x axis and driven in x
+    /// to 1.99999 m (0.01 mm short of stretched), where J hardly determines
+    /// the elbow's height.
+    #[test]
+    fn a_stall_near_a_stretched_toggle_names_the_least_determined_coordinates() {
+        let mech = flexmb_model::Scene::from_ron_str(
+            r#"(
+        dimension: Planar,
+        nodes: [ (id: "A", at: [0.0, 0.0]), (id: "B", at: [0.8, 0.6]), (id: "C", at: [1.6, 0.0]) ],
+        elements: [
+            (id: "ab", type: Truss(nodes: ("A", "B"), ea: 1.0e6, mass_per_length: 1.0)),
+            (id: "bc", type: Truss(nodes: ("B", "C"), ea: 1.0e6, mass_per_length: 1.0)),
+        ],
+        fixed: [ Coord("A", Position), Coord("C", Y) ],
+        rigid: [ Def("ab", "*"), Def("bc", "*") ],
+        prescribed: [ (what: Coord("C", X), function: Ramp(t0: 0.0, t1: 1.0, v0: 1.6, v1: 2.5)) ],
+    )"#,
+        )
+        .unwrap()
+        .build(None)
+        .unwrap();
+        let mut dy = Dynamics::new(Arc::new(mech));
+        let q = dy.mechanism().q0();
+        assert!(q.is_empty());
+        dy.kinematics_at(0.0, &q, None).unwrap();
+        let start = dy.kin.pivot_ratio();
+        // C.x = 1.6 + 0.9 t reaches 1.99999 m at t = 0.39999 / 0.9
+        let t_end = 0.39999 / 0.9;
+        for k in 1..=40 {
+            let t = t_end * (1.0 - (1.0 - k as f64 / 40.0).powi(3));
+            dy.kinematics_at(t, &q, None).unwrap();
+        }
+        let why = dy.explain_stall(t_end, &q, &q, start);
+        for part in [
+            "no evaluation failed",
+            "near a singular configuration",
+            "B.y",
+        ] {
+            assert!(why.contains(part), "`{part}` missing from: {why}");
+        }
+    }
+
     /// At a regular configuration a stall is explained by the largest
     /// accelerations: a free point mass of 2 kg under (0, −6) N accelerates
     /// by −3 m/s² in y, 0 in x.

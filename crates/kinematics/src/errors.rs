@@ -45,6 +45,22 @@ pub enum KinematicsError {
         /// Its value.
         value: f64,
     },
+    /// The converged configuration is not the one the last solution
+    /// continues to: Newton moved a dependent coordinate from the
+    /// first-order prediction by more than the prediction moved, even in the
+    /// finest (64) continuation steps from the last solution (the solve
+    /// jumped to another branch of the constraint equations, e.g. an elbow
+    /// that folded the other way, or the steps cross a branching
+    /// configuration).
+    #[error("the position solve jumped to another branch: {coordinate} moved {correction:.3e} away from its first-order prediction, more than the step's predicted motion ({predicted:.3e}), even in 64 continuation steps from the last solution: the mechanism passes a singular (branching) configuration between them; take smaller steps, or set a guess on the wanted branch (Kinematics::set_guess)")]
+    BranchJump {
+        /// The dependent coordinate with the largest correction.
+        coordinate: String,
+        /// Its distance from the first-order prediction.
+        correction: f64,
+        /// The largest motion the prediction made.
+        predicted: f64,
+    },
     /// An input slice of the wrong length (a caller's error).
     #[error("{what} has {got} entries, but this mechanism has {expected}")]
     Length {

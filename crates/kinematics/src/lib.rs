@@ -148,6 +148,9 @@ pub struct Kinematics {
     target: Vec<f64>,
     iterations: usize,
     x_good: Vec<f64>,
+    /// The first-order prediction of the current solve, for the branch
+    /// guard (`branch_jump` in position.rs).
+    x_predicted: Vec<f64>,
     xi_good: Vec<f64>,
     /// The target ξ = (q, u) of the current solve.
     xi_target: Vec<f64>,

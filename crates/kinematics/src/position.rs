@@ -11,6 +11,24 @@ use flexmb_model::{ERole, XRole};
 /// |x| carries an error of a few ε|x|; a deformation sums a few of them).
 const ROUNDING_RESIDUALS: f64 = 64.0;
 
+/// A converged solve whose Newton corrections moved a dependent coordinate
+/// by more than this fraction of the prediction's largest motion is taken for
+/// a step too large for the branch (continued from the last solution in
+/// smaller steps). Along a smooth branch the ratio is of the order of the
+/// step over the branch's radius of curvature; a solve that folded a
+/// two-link arm's elbow the other way had 0.37, legitimate steps of a tenth
+/// of the curvature radius have a few hundredths.
+const BRANCH_RATIO: f64 = 0.25;
+
+/// The continuation's finest division of a step, where a correction up to
+/// the whole predicted motion passes the branch guard.
+const FINEST_STEPS: usize = 64;
+
+/// Newton corrections below this fraction of the mechanism's length scale
+/// are never taken for a jump to another branch (a branch is a finite
+/// distance away; smaller corrections are of steps from a poor prediction).
+const BRANCH_NOISE: f64 = 1e-3;
+
 /// Newton settings of the position solve.
 #[derive(Clone, Copy, Debug)]
 pub struct NewtonOptions {
@@ -48,7 +66,7 @@ impl Kinematics {
     /// ε = D(x) of every element at the current x, with the element
     /// Jacobians D,x if `with_jac` (dual numbers: several times the cost of
     /// ε alone for a spatial beam, which Newton's trial steps need only).
-    fn eval_elements(&mut self, with_jac: bool) {
+    pub(crate) fn eval_elements(&mut self, with_jac: bool) {
         self.jac_at_x = with_jac;
         let mech = &self.mech;
         let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
@@ -104,7 +122,7 @@ impl Kinematics {
         Ok(())
     }
 
-    fn residual_norm(&self) -> f64 {
+    pub(crate) fn residual_norm(&self) -> f64 {
         self.mech
             .constraint_rows
             .iter()
@@ -213,7 +231,7 @@ impl Kinematics {
     /// [`solve_inner`](Self::solve_inner) for the full target ξ: one Newton
     /// solve, then a continuation from the last converged ξ if that fails.
     fn solve_to(&mut self, target: &[f64], mode: Refactor) -> Result<(), KinematicsError> {
-        let first = self.solve_xi(target, mode);
+        let first = self.solve_xi(target, mode, BRANCH_RATIO);
         if first.is_ok() || matches!(first, Err(KinematicsError::EulerParameterDegenerate { .. })) {
             return first;
         }
@@ -223,23 +241,34 @@ impl Kinematics {
         self.continuations += 1;
         let start = self.xi_good.clone();
         let mut err = first;
-        for n in [2usize, 4, 8, 16, 32, 64] {
+        for n in [2usize, 4, 8, 16, 32, FINEST_STEPS] {
             self.restore_last_solution();
             let mut ok = true;
             for j in 1..=n {
                 let s = j as f64 / n as f64;
+                // (the last step to the target itself, not to a rounding of it)
                 let mid: Vec<f64> = start
                     .iter()
                     .zip(target)
-                    .map(|(a, b)| a + s * (b - a))
+                    .map(|(a, b)| if j == n { *b } else { a + s * (b - a) })
                     .collect();
-                // intermediate solutions feed the F,ξ predictor: J at each
-                if let Err(e) = self.solve_xi(&mid, Refactor::AtSolution) {
-                    err = Err(e);
-                    ok = false;
-                    break;
+                // J factorized at each intermediate solution: the next
+                // step's chord predictor is of first order along the step
+                // in the finest steps, a correction up to the predicted
+                // motion itself is accepted: near a fold of the branch (a
+                // configuration at the edge of reach) the ratio grows as
+                // 1/distance to the fold however small the steps
+                let ratio = if n == FINEST_STEPS { 1.0 } else { BRANCH_RATIO };
+                match self.solve_xi(&mid, Refactor::AtSolution, ratio) {
+                    Ok(()) => {}
+                    // the chart's limit: smaller steps do not pass it
+                    Err(e @ KinematicsError::EulerParameterDegenerate { .. }) => return Err(e),
+                    Err(e) => {
+                        err = Err(e);
+                        ok = false;
+                        break;
+                    }
                 }
-                self.first_order();
             }
             if ok {
                 return Ok(());
@@ -256,7 +285,16 @@ impl Kinematics {
     /// [`Refactor::AtSolution`] J is also factorized at the converged point
     /// (F,ξ needs it there); with [`Refactor::WhenSlow`] the last factorization
     /// may be of a nearby configuration, and `lu_at_x` says whether it is not.
-    fn solve_xi(&mut self, xi: &[f64], mode: Refactor) -> Result<(), KinematicsError> {
+    ///
+    /// The branch guard ([`branch_jump`](Self::branch_jump)) refuses a
+    /// solution whose Newton corrections exceed `branch_ratio` times the
+    /// prediction's motion.
+    fn solve_xi(
+        &mut self,
+        xi: &[f64],
+        mode: Refactor,
+        branch_ratio: f64,
+    ) -> Result<(), KinematicsError> {
         let n_q = self.n_q;
         self.xi_prev.copy_from_slice(&self.xi);
         self.xi.copy_from_slice(xi);
@@ -267,6 +305,18 @@ impl Kinematics {
                 ERole::Input(k) => self.xi[n_q + k],
                 _ => 0.0,
             };
+        }
+        // the branch guard compares the solution with the prediction from
+        // the last solution (not with a guess of `set_guess`)
+        let guard = self.have_solution;
+        if guard && !self.first_order_valid && !self.lu_valid && self.xi != self.xi_prev {
+            // no derivative at hand (the reference, or a restored solution):
+            // factorize J there for the chord predictor (a singular J
+            // leaves none: the guard then compares with the unpredicted x)
+            let _ = self.factor_at_x();
+        }
+        if guard {
+            self.x_predicted.copy_from_slice(&self.x);
         }
         let mut moved = self.have_solution && self.predict();
         self.first_order_valid = false;
@@ -281,6 +331,15 @@ impl Kinematics {
             if self.x[i] != v {
                 self.x[i] = v;
                 moved = true;
+            }
+        }
+        // the motion the prediction made (0 without a guard), and the
+        // predicted configuration
+        let mut predicted = 0.0f64;
+        if guard {
+            for (p, x) in self.x_predicted.iter_mut().zip(&self.x) {
+                predicted = predicted.max((x - *p).abs());
+                *p = *x;
             }
         }
         if moved {
@@ -324,7 +383,15 @@ impl Kinematics {
                     <= 8.0 * f64::EPSILON * x_scale
                 && res <= (1e3 * tol).max(ROUNDING_RESIDUALS * f64::EPSILON * x_scale);
             if res <= tol || stalled {
-                outcome = Some(self.converged(it, mode));
+                // (a node at its chart's limit is named as such, not as a
+                // branch jump: smaller steps do not help there)
+                let jump = guard
+                    .then(|| self.branch_jump(predicted, branch_ratio))
+                    .flatten();
+                outcome = Some(match jump {
+                    Some(jump) => Err(self.check_euler_parameters().err().unwrap_or(jump)),
+                    None => self.converged(it, mode),
+                });
                 break;
             }
             if it == self.opts.max_iterations {
@@ -368,6 +435,32 @@ impl Kinematics {
         };
         self.last_update = last_update;
         result
+    }
+
+    /// The [`KinematicsError::BranchJump`] of a converged Newton solve whose
+    /// corrections moved a dependent coordinate from the first-order
+    /// prediction by more than `ratio` times the largest motion of
+    /// the prediction (`predicted`, the known coordinates' included): along
+    /// a smooth branch the correction is of second order in the step and the
+    /// prediction of first order, so this happens for steps too large for the
+    /// branch's curvature, and when Newton lands on another branch of the
+    /// constraint equations (an elbow folded the other way). Corrections
+    /// within [`BRANCH_NOISE`] of the length scale are never a jump.
+    fn branch_jump(&self, predicted: f64, ratio: f64) -> Option<KinematicsError> {
+        let (mut correction, mut at) = (0.0f64, 0);
+        for &i in &self.mech.dependent {
+            let c = (self.x[i] - self.x_predicted[i]).abs();
+            if c > correction {
+                (correction, at) = (c, i);
+            }
+        }
+        (correction > ratio * predicted && correction > BRANCH_NOISE * self.length_scale).then(
+            || KinematicsError::BranchJump {
+                coordinate: self.mech.x_names[at].clone(),
+                correction,
+                predicted,
+            },
+        )
     }
 
     /// x_dep += s · dx.

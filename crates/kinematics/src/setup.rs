@@ -6,7 +6,7 @@
 use crate::jacobian_lu::{JacobianLu, DENSE_UP_TO};
 use crate::{ElemMap, Kinematics, NewtonOptions, XiEntry, NO_ENTRY};
 use faer::Mat;
-use flexmb_model::{Coordinate, Mechanism, XRole};
+use flexmb_model::{Coordinate, ERole, Mechanism, XRole};
 use std::sync::Arc;
 
 impl Kinematics {
@@ -121,6 +121,7 @@ impl Kinematics {
             target: vec![0.0; n_c],
             iterations: 0,
             x_good: mech.x0.clone(),
+            x_predicted: mech.x0.clone(),
             xi_good: vec![0.0; n_xi],
             xi_target: vec![0.0; n_xi],
             lu_valid: false,
@@ -138,8 +139,37 @@ impl Kinematics {
             mech,
         };
         s.xi[..n_q].copy_from_slice(&s.mech.q0());
+        for (k, inp) in s.mech.inputs.iter().enumerate() {
+            if let Coordinate::Node(i) = inp.target {
+                s.xi[n_q + k] = s.mech.x0[i];
+            }
+        }
         s.xi_good.copy_from_slice(&s.xi);
+        s.xi_prev.copy_from_slice(&s.xi);
+        s.start_from_reference();
         s
+    }
+
+    /// Takes the reference configuration as the last solution when it
+    /// solves the constraint equations for ξ0 = (q0, u0) (the DOFs and inputs
+    /// read off the reference): the first solve then predicts from it and
+    /// stays on its branch, as every later solve stays on the branch of the
+    /// one before (`branch_jump` in position.rs).
+    fn start_from_reference(&mut self) {
+        let n_q = self.n_q;
+        for (r, j) in self.mech.constraint_rows.iter().enumerate() {
+            self.target[r] = match self.mech.e_roles[*j] {
+                ERole::Dof(k) => self.xi[k],
+                ERole::Input(k) => self.xi[n_q + k],
+                _ => 0.0,
+            };
+        }
+        self.eval_elements(true);
+        let tol = self.opts.tol * self.length_scale.max(1e-6);
+        if self.eps.iter().all(|v| v.is_finite()) && self.residual_norm() <= tol {
+            self.prev_eps.copy_from_slice(&self.eps);
+            self.have_solution = true;
+        }
     }
 }
 
