@@ -89,14 +89,25 @@ use workspace::Workspace;
 /// (`workspace.rs`).
 pub struct Kinematics {
     mech: Arc<Mechanism>,
+    /// Fixed after construction.
     layout: Layout,
+    /// Newton options and the stop flag, set by the caller.
     settings: Settings,
+    /// t, ξ, x, ε of the last solve, the branch and the last good solution.
     config: Configuration,
+    /// D,x of every element; `at_x` when of `config.x`.
     jac: ElementJacobians,
+    /// The LU of J; `valid` when usable, `at_x` (implies `valid`) when of
+    /// `config.x`.
     factorization: Factorization,
+    /// F,ξ and E,ξ; `valid` when of `config.x`.
     first: FirstOrderCache,
+    /// ξ̇, ẋ, ε̇, ẍ0, ε̈0, D,xx\[ẋ, ẋ\] of the last rate evaluations.
     rates: Rates,
+    /// Newton iterations, factorizations, refinements, continuations.
     counters: Counters,
+    /// Scratch buffers (content meaningless between calls but for the
+    /// failure report's `target` and `last_update`).
     ws: Workspace,
 }
 

@@ -199,23 +199,23 @@ impl Kinematics {
                 name: flexmb_model::list_some(&bad, |k| self.mech.dof_label(k)),
             });
         }
-        // ξ = (q, u) in a buffer kept between solves (no allocation per
-        // solve), taken out while `solve_to` needs all of `self`
-        let mut target = std::mem::take(&mut self.ws.xi_target);
+        // the target ξ = (q, u), in a buffer kept between solves (no
+        // allocation per solve)
+        let target = &mut self.ws.xi_target;
         target[..n_q].copy_from_slice(q);
         for k in 0..n_u {
             target[n_q + k] = self.mech.inputs[k].function.value(t);
         }
         self.config.t = t;
-        let r = self.solve_to(&target, mode);
-        self.ws.xi_target = target;
-        r
+        self.solve_to(mode)
     }
 
-    /// [`solve_inner`](Self::solve_inner) for the full target ξ: one Newton
-    /// solve, then a continuation from the last converged ξ if that fails.
-    fn solve_to(&mut self, target: &[f64], mode: Refactor) -> Result<(), KinematicsError> {
-        let first = self.solve_xi(target, mode);
+    /// [`solve_inner`](Self::solve_inner) for the full target ξ in
+    /// `ws.xi_target`: one Newton solve, then a continuation from the last
+    /// converged ξ if that fails.
+    fn solve_to(&mut self, mode: Refactor) -> Result<(), KinematicsError> {
+        self.step_xi(None);
+        let first = self.solve_xi(mode);
         if first.is_ok() || matches!(first, Err(KinematicsError::EulerParameterDegenerate { .. })) {
             return first;
         }
@@ -223,20 +223,14 @@ impl Kinematics {
         // in 2, 4, …, 64 equal steps of ξ (large jumps, e.g. a first solve far
         // from the reference configuration)
         self.counters.continuations += 1;
-        let start = self.config.xi_good.clone();
         let mut err = first;
         for n in [2usize, 4, 8, 16, 32, 64] {
             self.restore_last_solution();
             let mut ok = true;
             for j in 1..=n {
-                let s = j as f64 / n as f64;
-                let mid: Vec<f64> = start
-                    .iter()
-                    .zip(target)
-                    .map(|(a, b)| a + s * (b - a))
-                    .collect();
+                self.step_xi(Some(j as f64 / n as f64));
                 // intermediate solutions feed the F,ξ predictor: J at each
-                if let Err(e) = self.solve_xi(&mid, Refactor::AtSolution) {
+                if let Err(e) = self.solve_xi(Refactor::AtSolution) {
                     err = Err(e);
                     ok = false;
                     break;
@@ -250,7 +244,26 @@ impl Kinematics {
         err
     }
 
-    /// One Newton solve for the full ξ = (q, u).
+    /// Sets the ξ of the next Newton solve, keeping the current one as
+    /// `xi_prev`: the target `ws.xi_target`, or with `Some(s)` the point a
+    /// fraction s of the way to it from the last converged ξ (continuation;
+    /// `xi_good` does not change while the continuation runs).
+    fn step_xi(&mut self, s: Option<f64>) {
+        let c = &mut self.config;
+        c.xi_prev.copy_from_slice(&c.xi);
+        let target = &self.ws.xi_target;
+        match s {
+            None => c.xi.copy_from_slice(target),
+            Some(s) => {
+                for ((xi, a), b) in c.xi.iter_mut().zip(&c.xi_good).zip(target) {
+                    *xi = a + s * (b - a);
+                }
+            }
+        }
+    }
+
+    /// One Newton solve for the ξ = (q, u) that
+    /// [`step_xi`](Self::step_xi) set.
     ///
     /// Chord Newton: the factorization of J is kept from step to step (and
     /// from the previous solve) while the residual shrinks at least tenfold
@@ -259,11 +272,9 @@ impl Kinematics {
     /// (F,ξ needs it there); with [`Refactor::WhenSlow`] the last factorization
     /// may be of a nearby configuration, and `Factorization::at_x` says whether
     /// it is not.
-    fn solve_xi(&mut self, xi: &[f64], mode: Refactor) -> Result<(), KinematicsError> {
+    fn solve_xi(&mut self, mode: Refactor) -> Result<(), KinematicsError> {
         let n_q = self.layout.n_q;
-        let c = &mut self.config;
-        c.xi_prev.copy_from_slice(&c.xi);
-        c.xi.copy_from_slice(xi);
+        let c = &self.config;
         // targets of the constraint rows
         for (r, j) in self.mech.constraint_rows.iter().enumerate() {
             self.ws.target[r] = match self.mech.e_roles[*j] {

@@ -18,7 +18,7 @@ impl Kinematics {
         let n_c = mech.constraint_rows.len();
         // c_k = D,xx[F e_k, ẋ] for every deformation
         let mut c = Mat::<f64>::zeros(n_e, n_q);
-        self.directional_second(&mut c, |_, _| None);
+        self.directional_second(&mut c);
         let mut rhs = Mat::from_fn(n_c, n_q, |r, k| -c[(mech.constraint_rows[r], k)]);
         self.factorization.lu.solve_in_place(rhs.as_mut());
         let mut x1 = Mat::<f64>::zeros(n_x, n_q);
@@ -135,11 +135,7 @@ impl Kinematics {
     }
 
     /// out(j, k) = D_j,xx\[F,q e_k, ẋ\] for every deformation.
-    fn directional_second(
-        &self,
-        out: &mut Mat<f64>,
-        _unused: impl Fn(usize, usize) -> Option<f64>,
-    ) {
+    fn directional_second(&self, out: &mut Mat<f64>) {
         let n_q = self.layout.n_q;
         let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];

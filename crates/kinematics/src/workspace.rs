@@ -5,10 +5,12 @@
 //! position solve reads.
 //!
 //! Being one field of `Kinematics` apart from the state and the caches, the
-//! buffers can be borrowed mutably next to them (`self.ws.dx` while
-//! `self.layout` and `self.jac` are read). A method that needs `&mut self`
-//! as a whole while it holds a buffer takes the buffer out with
-//! `std::mem::take` and puts it back; those are marked where they are.
+//! buffers are borrowed mutably next to them (`self.ws.dx` while
+//! `self.layout` and `self.jac` are read), so no method takes a buffer out
+//! of `self` to call another: a step that needs `&mut self` as a whole (a
+//! factorization, the next Newton solve) reads its input from and writes
+//! its result to named buffers here (e.g. the solves along a direction:
+//! `xi_dir` and `vel_rhs` in, `dep` out).
 
 use faer::Mat;
 
