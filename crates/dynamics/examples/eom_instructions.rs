@@ -15,7 +15,8 @@
 //! (q, q̇), as the bench's "at one state"; "trajectory" evaluates, in
 //! order, the states a DOPRI5 run of the first 2 ms from rest asked for, as
 //! its "along a trajectory". Divide the collected instructions by the count
-//! printed.
+//! printed. The digest printed of the bits of q̈ shows whether a change
+//! meant to keep every result kept it to the last bit.
 
 use flexmb_dynamics::{integrate_explicit, Control, Dynamics, Integrator, SimulationOptions};
 use flexmb_model::Scene;
@@ -66,14 +67,29 @@ fn one_state(dy: &mut Dynamics, q: &[f64], qd: &[f64], qdd: &mut [f64]) {
 }
 
 /// One evaluation at each recorded state, in order (the counted region of
-/// "trajectory").
+/// "trajectory"); the digest of every q̈.
 #[inline(never)]
-fn along_trajectory(dy: &mut Dynamics, states: &[(f64, Vec<f64>)], qdd: &mut [f64]) {
+fn along_trajectory(dy: &mut Dynamics, states: &[(f64, Vec<f64>)], qdd: &mut [f64]) -> u64 {
     let n = dy.n_q();
+    let mut digest = 0;
     for (t, y) in states {
         dy.accelerations(*t, black_box(&y[..n]), &y[n..], qdd)
             .unwrap();
+        digest = bits_digest(digest, qdd);
     }
+    digest
+}
+
+/// An FNV-1a digest of the bit patterns of `v`, continuing `h` (0 to
+/// start): equal digests before and after a change that should not change
+/// any result show it did not, to the last bit.
+fn bits_digest(h: u64, v: &[f64]) -> u64 {
+    let mut h = if h == 0 { 0xcbf2_9ce4_8422_2325 } else { h };
+    for x in v {
+        h ^= x.to_bits();
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
 }
 
 fn main() {
@@ -93,7 +109,10 @@ fn main() {
             let qd: Vec<f64> = (0..n).map(|i| 1e-2 * ((i % 5) as f64 - 2.0)).collect();
             dy.accelerations(0.05, &q, &qd, &mut qdd).unwrap();
             one_state(&mut dy, &q, &qd, &mut qdd);
-            println!("{REPEATS} evaluations at one state; q̈[0] = {:e}", qdd[0]);
+            println!(
+                "{REPEATS} evaluations at one state; digest of q̈ {:016x}",
+                bits_digest(0, &qdd)
+            );
         }
         "trajectory" => {
             let mut y0 = dy.mechanism().q0();
@@ -107,9 +126,9 @@ fn main() {
             integrate_explicit(&mut rec, &opts, 0.0, &y0, |_, _, _| Control::Continue).unwrap();
             let states = rec.states;
             let mut dy = load();
-            along_trajectory(&mut dy, &states, &mut qdd);
+            let digest = along_trajectory(&mut dy, &states, &mut qdd);
             println!(
-                "{} evaluations along the trajectory; {} factorizations, {} refinement steps",
+                "{} evaluations along the trajectory (digest of every q̈ {digest:016x}); {} factorizations, {} refinement steps",
                 states.len(),
                 dy.kinematics().factorizations(),
                 dy.kinematics().refinements()
