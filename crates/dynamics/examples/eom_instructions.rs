@@ -5,7 +5,7 @@
 //!
 //! ```text
 //! cargo build --release -p flexmb-dynamics --example eom_instructions
-//! valgrind --tool=callgrind --toggle-collect='eom_instructions::one_state' \
+//! valgrind --tool=callgrind --toggle-collect='eom_instructions::at_one_state' \
 //!     target/release/examples/eom_instructions one-state
 //! valgrind --tool=callgrind --toggle-collect='eom_instructions::along_trajectory' \
 //!     target/release/examples/eom_instructions trajectory
@@ -18,49 +18,19 @@
 //! printed. The digest printed of the bits of q̈ shows whether a change
 //! meant to keep every result kept it to the last bit.
 
-use flexmb_dynamics::{integrate_explicit, Control, Dynamics, Integrator, SimulationOptions};
-use flexmb_model::Scene;
-use flexmb_ode::{OdeSystem, RhsError};
+#[path = "../benches/common/mod.rs"]
+mod common;
+
+use common::{load, one_state, trajectory};
+use flexmb_dynamics::Dynamics;
 use std::hint::black_box;
-use std::path::Path;
-use std::sync::Arc;
 
 const SCENE: &str = "straight_guidance_spatial.ron";
 const REPEATS: usize = 1000;
 
-fn load() -> Dynamics {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/scenes")
-        .join(SCENE);
-    Dynamics::new(Arc::new(Scene::load(&p).unwrap().build(None).unwrap()))
-}
-
-/// The first-order system of `dy`, recording every state it is evaluated at.
-struct Recorder<'a> {
-    dy: &'a mut Dynamics,
-    states: Vec<(f64, Vec<f64>)>,
-    qdd: Vec<f64>,
-}
-
-impl OdeSystem for Recorder<'_> {
-    fn dim(&self) -> usize {
-        2 * self.dy.n_q()
-    }
-    fn rhs(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RhsError> {
-        let n = self.dy.n_q();
-        self.states.push((t, y.to_vec()));
-        self.dy
-            .accelerations(t, &y[..n], &y[n..], &mut self.qdd)
-            .map_err(|e| RhsError::new(e.to_string()))?;
-        out[..n].copy_from_slice(&y[n..]);
-        out[n..].copy_from_slice(&self.qdd);
-        Ok(())
-    }
-}
-
 /// `REPEATS` evaluations at one state (the counted region of "one-state").
 #[inline(never)]
-fn one_state(dy: &mut Dynamics, q: &[f64], qd: &[f64], qdd: &mut [f64]) {
+fn at_one_state(dy: &mut Dynamics, q: &[f64], qd: &[f64], qdd: &mut [f64]) {
     for _ in 0..REPEATS {
         dy.accelerations(0.05, black_box(q), qd, qdd).unwrap();
     }
@@ -94,38 +64,20 @@ fn bits_digest(h: u64, v: &[f64]) -> u64 {
 
 fn main() {
     let mode = std::env::args().nth(1).unwrap_or_default();
-    let mut dy = load();
-    let n = dy.n_q();
-    let mut qdd = vec![0.0; n];
+    let mut dy = load(SCENE);
+    let mut qdd = vec![0.0; dy.n_q()];
     match mode.as_str() {
         "one-state" => {
-            let q: Vec<f64> = dy
-                .mechanism()
-                .q0()
-                .iter()
-                .enumerate()
-                .map(|(i, v)| v + 1e-4 * ((i % 7) as f64 - 3.0))
-                .collect();
-            let qd: Vec<f64> = (0..n).map(|i| 1e-2 * ((i % 5) as f64 - 2.0)).collect();
+            let (q, qd) = one_state(&dy);
             dy.accelerations(0.05, &q, &qd, &mut qdd).unwrap();
-            one_state(&mut dy, &q, &qd, &mut qdd);
+            at_one_state(&mut dy, &q, &qd, &mut qdd);
             println!(
                 "{REPEATS} evaluations at one state; digest of q̈ {:016x}",
                 bits_digest(0, &qdd)
             );
         }
         "trajectory" => {
-            let mut y0 = dy.mechanism().q0();
-            y0.extend(vec![0.0; n]);
-            let mut rec = Recorder {
-                dy: &mut dy,
-                states: vec![],
-                qdd: vec![0.0; n],
-            };
-            let opts = SimulationOptions::new(Integrator::Dopri5, 0.0, 2e-3, 4);
-            integrate_explicit(&mut rec, &opts, 0.0, &y0, |_, _, _| Control::Continue).unwrap();
-            let states = rec.states;
-            let mut dy = load();
+            let states = trajectory(SCENE);
             let digest = along_trajectory(&mut dy, &states, &mut qdd);
             println!(
                 "{} evaluations along the trajectory (digest of every q̈ {digest:016x}); {} factorizations, {} refinement steps",
