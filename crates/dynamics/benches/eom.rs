@@ -8,62 +8,11 @@
 //! for, so chord Newton steps, a factorization of an earlier configuration
 //! and its refinement, and refactorizations happen as in a simulation.
 
+mod common;
+
+use common::{load, one_state, trajectory};
 use criterion::{criterion_group, criterion_main, Criterion};
-use flexmb_dynamics::{integrate_explicit, Dynamics, Integrator, SimulationOptions};
-use flexmb_model::Scene;
-use flexmb_ode::{OdeSystem, RhsError};
 use std::hint::black_box;
-use std::path::Path;
-use std::sync::Arc;
-
-fn load(name: &str) -> Dynamics {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../fixtures/scenes")
-        .join(name);
-    Dynamics::new(Arc::new(Scene::load(&p).unwrap().build(None).unwrap()))
-}
-
-/// The first-order system of `dy`, recording every state it is evaluated at.
-struct Recorder<'a> {
-    dy: &'a mut Dynamics,
-    states: Vec<(f64, Vec<f64>)>,
-    qdd: Vec<f64>,
-}
-
-impl OdeSystem for Recorder<'_> {
-    fn dim(&self) -> usize {
-        2 * self.dy.n_q()
-    }
-    fn rhs(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RhsError> {
-        let n = self.dy.n_q();
-        self.states.push((t, y.to_vec()));
-        self.dy
-            .accelerations(t, &y[..n], &y[n..], &mut self.qdd)
-            .map_err(|e| RhsError::new(e.to_string()))?;
-        out[..n].copy_from_slice(&y[n..]);
-        out[n..].copy_from_slice(&self.qdd);
-        Ok(())
-    }
-}
-
-/// The states of the first 2 ms of the response from rest at q0.
-fn trajectory(file: &str) -> Vec<(f64, Vec<f64>)> {
-    let mut dy = load(file);
-    let n = dy.n_q();
-    let mut y0 = dy.mechanism().q0();
-    y0.extend(vec![0.0; n]);
-    let mut rec = Recorder {
-        dy: &mut dy,
-        states: vec![],
-        qdd: vec![0.0; n],
-    };
-    let opts = SimulationOptions::new(Integrator::Dopri5, 0.0, 2e-3, 4);
-    integrate_explicit(&mut rec, &opts, 0.0, &y0, |_, _, _| {
-        flexmb_dynamics::Control::Continue
-    })
-    .unwrap();
-    rec.states
-}
 
 fn eom(c: &mut Criterion) {
     for (name, file) in [
@@ -72,14 +21,7 @@ fn eom(c: &mut Criterion) {
     ] {
         let mut dy = load(file);
         let n = dy.n_q();
-        let q: Vec<f64> = dy
-            .mechanism()
-            .q0()
-            .iter()
-            .enumerate()
-            .map(|(i, v)| v + 1e-4 * ((i % 7) as f64 - 3.0))
-            .collect();
-        let qd: Vec<f64> = (0..n).map(|i| 1e-2 * ((i % 5) as f64 - 2.0)).collect();
+        let (q, qd) = one_state(&dy);
         let mut qdd = vec![0.0; n];
         dy.accelerations(0.05, &q, &qd, &mut qdd).unwrap();
         let mut g = c.benchmark_group(name);

@@ -10,20 +10,21 @@ impl Kinematics {
     /// configuration and velocities (zero for elements at rest), the
     /// velocity-quadratic part of ε̈ = D,x ẍ + D,xx\[ẋ, ẋ\] (thesis (5.8b)).
     pub fn convective_terms(&mut self) -> &[f64] {
+        let rates = &mut self.rates;
         let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in self.mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
+            let m = &self.layout.maps[ei];
             if m.ne == 0 {
                 continue;
             }
             let mut moving = false;
             for (k, gi) in e.x_index.iter().enumerate() {
-                xl[k] = self.x[*gi];
-                vl[k] = self.xd[*gi];
+                xl[k] = self.config.x[*gi];
+                vl[k] = rates.xd[*gi];
                 moving |= vl[k] != 0.0;
             }
-            let out = &mut self.dxx_vv[e.eps_offset..e.eps_offset + m.ne];
+            let out = &mut rates.dxx_vv[e.eps_offset..e.eps_offset + m.ne];
             if moving {
                 e.element
                     .deformation_second_derivative(&xl[..m.nx], &vl[..m.nx], &vl[..m.nx], out);
@@ -31,7 +32,7 @@ impl Kinematics {
                 out.fill(0.0);
             }
         }
-        &self.dxx_vv
+        &self.rates.dxx_vv
     }
 
     /// The accelerations for q̈ = 0: ẍ0 = F,u ü + (F,ξξ ξ̇)ξ̇ and the matching
@@ -41,39 +42,35 @@ impl Kinematics {
         self.ensure_lu_at_x();
         // c = D,xx[ẋ, ẋ] per element
         self.convective_terms();
-        self.epsdd0.copy_from_slice(&self.dxx_vv);
         // the direction ξ̈ = (0, ü)
-        let mut dir = std::mem::take(&mut self.xi_dir);
-        self.second_derivative_direction(None, &mut dir);
-        let mut rhs = std::mem::take(&mut self.rhs_vec);
-        self.direction_rhs(&dir, true, &mut rhs);
-        self.lu.solve_vec(&mut rhs);
-        let mut xdd0 = std::mem::take(&mut self.xdd0);
-        self.scatter_direction(&dir, &rhs, &mut xdd0);
-        self.xdd0 = xdd0;
-        self.rhs_vec = rhs;
+        self.second_derivative_direction(None);
+        let (layout, mech, rates, ws) = (&self.layout, &*self.mech, &mut self.rates, &mut self.ws);
+        rates.epsdd0.copy_from_slice(&rates.dxx_vv);
+        let dir = &ws.xi_dir;
+        layout.direction_rhs(mech, &self.jac.local, Some(&rates.dxx_vv), dir, &mut ws.dep);
+        self.factorization.lu.solve_vec(&mut ws.dep);
+        layout.scatter_direction(mech, dir, &ws.dep, &mut rates.xdd0);
         // ε̈0 = D,x ẍ0 + D,xx[ẋ, ẋ] (rows: exact targets)
-        let n_q = self.n_q;
-        for (ei, e) in self.mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
+        let n_q = layout.n_q;
+        for (ei, e) in mech.elements.iter().enumerate() {
+            let m = &layout.maps[ei];
+            let jl = &self.jac.local[ei];
             for a in 0..m.ne {
                 let j = e.eps_offset + a;
-                if self.row_of[j].is_some() {
-                    self.epsdd0[j] = match self.mech.e_roles[j] {
+                if layout.row_of[j].is_some() {
+                    rates.epsdd0[j] = match mech.e_roles[j] {
                         ERole::Input(k) => dir[n_q + k],
                         _ => 0.0,
                     };
                     continue;
                 }
-                let mut s = self.epsdd0[j];
+                let mut s = rates.epsdd0[j];
                 for (cc, gi) in e.x_index.iter().enumerate() {
-                    s += jl[a * m.nx + cc] * self.xdd0[*gi];
+                    s += jl[a * m.nx + cc] * rates.xdd0[*gi];
                 }
-                self.epsdd0[j] = s;
+                rates.epsdd0[j] = s;
             }
         }
-        self.xi_dir = dir;
     }
 
     /// The nodal accelerations ẍ = F,q q̈ + F,u ü + (F,ξξ ξ̇)ξ̇ for the given
@@ -92,26 +89,27 @@ impl Kinematics {
         xdd: &mut [f64],
     ) -> Result<(), KinematicsError> {
         self.check_lengths(&[
-            ("q̈", qdd.len(), self.n_q),
+            ("q̈", qdd.len(), self.layout.n_q),
             ("ẍ", xdd.len(), self.mech.n_x()),
         ])?;
         self.convective_terms();
-        let mut dir = std::mem::take(&mut self.xi_dir);
-        self.second_derivative_direction(Some(qdd), &mut dir);
-        let solved = self.solve_direction(&dir, true, xdd);
-        self.xi_dir = dir;
-        solved
+        self.second_derivative_direction(Some(qdd));
+        self.solve_along_direction(true)?;
+        self.layout
+            .scatter_direction(&self.mech, &self.ws.xi_dir, &self.ws.dep, xdd);
+        Ok(())
     }
 
-    /// ξ̈ = (q̈, ü(t)) into `dir`, q̈ = 0 when not given.
-    fn second_derivative_direction(&self, qdd: Option<&[f64]>, dir: &mut [f64]) {
-        let n_q = self.n_q;
+    /// ξ̈ = (q̈, ü(t)) into `ws.xi_dir`, q̈ = 0 when not given.
+    fn second_derivative_direction(&mut self, qdd: Option<&[f64]>) {
+        let n_q = self.layout.n_q;
+        let dir = &mut self.ws.xi_dir;
         match qdd {
             Some(qdd) => dir[..n_q].copy_from_slice(qdd),
             None => dir[..n_q].fill(0.0),
         }
         for (k, u) in self.mech.inputs.iter().enumerate() {
-            dir[n_q + k] = u.function.eval(self.t).2;
+            dir[n_q + k] = u.function.eval(self.config.t).2;
         }
     }
 }

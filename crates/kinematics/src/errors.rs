@@ -98,13 +98,14 @@ impl Kinematics {
         let names = if n <= DENSE_UP_TO {
             self.null_space_names()
         } else {
-            self.lu
+            self.factorization
+                .lu
                 .smallest_pivot_column()
                 .map(|c| vec![self.mech.x_names[self.mech.dependent[c]].clone()])
                 .unwrap_or_default()
         };
         KinematicsError::Singular {
-            pivot_ratio: self.lu.pivot_ratio,
+            pivot_ratio: self.factorization.lu.pivot_ratio,
             coordinates: names,
         }
     }
@@ -126,7 +127,7 @@ impl Kinematics {
     /// smallest singular value's right singular vector).
     fn null_space_names(&self) -> Vec<String> {
         let mut names = vec![];
-        if let Ok(svd) = flexmb_linalg::svd(self.lu.to_dense().as_ref()) {
+        if let Ok(svd) = flexmb_linalg::svd(self.factorization.lu.to_dense().as_ref()) {
             let n = svd.s.len();
             if n > 0 {
                 let v = &svd.v;
@@ -143,7 +144,9 @@ impl Kinematics {
     }
 
     /// The failure report of a position solve that did not converge.
-    pub(crate) fn not_converged(&self, last_update: &[f64]) -> KinematicsError {
+    /// The last Newton update taken is `Workspace::last_update`.
+    pub(crate) fn not_converged(&self) -> KinematicsError {
+        let last_update = &self.ws.last_update;
         let mut eq: Vec<(f64, String)> = self
             .mech
             .constraint_rows
@@ -151,7 +154,7 @@ impl Kinematics {
             .enumerate()
             .map(|(r, j)| {
                 (
-                    (self.eps[*j] - self.target[r]).abs(),
+                    (self.config.eps[*j] - self.ws.target[r]).abs(),
                     self.mech.eps_names[*j].clone(),
                 )
             })
@@ -178,7 +181,7 @@ impl Kinematics {
         };
         KinematicsError::NotConverged {
             hint: hint.into(),
-            iterations: self.opts.max_iterations,
+            iterations: self.settings.newton.max_iterations,
             residual,
             equations: eq
                 .iter()

@@ -31,65 +31,55 @@ impl Kinematics {
     /// the last Newton iteration (thesis (5.8a), (6.6a)).
     pub fn first_order(&mut self) {
         self.ensure_lu_at_x();
-        let (n_q, n_u) = (self.n_q, self.n_u);
-        let n_xi = n_q + n_u;
-        self.rhs.fill(0.0);
+        let layout = &self.layout;
+        let n_xi = layout.n_xi();
+        let (rhs, first) = (&mut self.ws.rhs, &mut self.first);
+        rhs.fill(0.0);
         // deformation coordinates in ξ: unit entries on their rows
-        for (j, k) in self.xi_of_e.iter().enumerate() {
-            if let (Some(k), Some(r)) = (k, self.row_of[j]) {
-                self.rhs[(r, *k)] = 1.0;
+        for (j, k) in layout.xi_of_e.iter().enumerate() {
+            if let (Some(k), Some(r)) = (k, layout.row_of[j]) {
+                rhs[(r, *k)] = 1.0;
             }
         }
         // nodal coordinates in ξ: −∂D_c/∂x_i
-        let mut rhs = std::mem::replace(&mut self.rhs, Mat::new());
-        self.for_each_nodal_xi_entry(|r, k, d| rhs[(r, k)] -= d);
-        self.rhs = rhs;
-        self.lu.solve_in_place(self.rhs.as_mut());
+        layout.for_each_nodal_xi_entry(&self.jac.local, |r, k, d| rhs[(r, k)] -= d);
+        self.factorization.lu.solve_in_place(rhs.as_mut());
         // rows of fixed coordinates stay zero and those of ξ stay unit: only
         // the dependent rows change (F and E start as zeros)
         for c in 0..n_xi {
-            let src = self.rhs.col_as_slice(c);
-            let dst = self.f.col_as_slice_mut(c);
+            let src = rhs.col_as_slice(c);
+            let dst = first.f.col_as_slice_mut(c);
             for (k, &i) in self.mech.dependent.iter().enumerate() {
                 dst[i] = src[k];
             }
         }
-        for (i, k) in self.xi_of_x.iter().enumerate() {
+        for (i, k) in layout.xi_of_x.iter().enumerate() {
             if let Some(k) = k {
-                self.f[(i, *k)] = 1.0;
+                first.f[(i, *k)] = 1.0;
             }
         }
         // E,ξ = D,x F,ξ on the deformations that are not constraint rows;
         // exact (zero or unit) on rigid / DOF / input rows
-        for (j, k) in self.xi_of_e.iter().enumerate() {
-            if let (Some(k), Some(_)) = (k, self.row_of[j]) {
-                self.e[(j, *k)] = 1.0;
+        for (j, k) in layout.xi_of_e.iter().enumerate() {
+            if let (Some(k), Some(_)) = (k, layout.row_of[j]) {
+                first.e[(j, *k)] = 1.0;
             }
         }
-        for &(ei, a) in &self.free_deformations {
+        for &(ei, a) in &layout.free_deformations {
             let e = &self.mech.elements[ei];
-            let nx = self.maps[ei].nx;
-            let row = &self.jac_local[ei][a * nx..(a + 1) * nx];
+            let nx = layout.maps[ei].nx;
+            let row = &self.jac.local[ei][a * nx..(a + 1) * nx];
             let j = e.eps_offset + a;
             for col in 0..n_xi {
-                let fcol = self.f.col_as_slice(col);
+                let fcol = first.f.col_as_slice(col);
                 let mut s = 0.0;
                 for (c, gi) in e.x_index.iter().enumerate() {
                     s += row[c] * fcol[*gi];
                 }
-                self.e[(j, col)] = s;
+                first.e[(j, col)] = s;
             }
         }
-        self.first_order_valid = true;
-    }
-
-    /// Visits the entries ∂D_r/∂x_i of the constraint rows r with respect to
-    /// the nodal coordinates x_i that belong to ξ (k = ξ index of x_i): the
-    /// nodal columns of the right-hand side B of (5.8a), up to sign.
-    pub(crate) fn for_each_nodal_xi_entry(&self, mut visit: impl FnMut(usize, usize, f64)) {
-        for e in &self.xi_entries {
-            visit(e.row, e.col, self.jac_local[e.element][e.local]);
-        }
+        first.valid = true;
     }
 
     /// F,ξᵀ y for a vector y over the nodal coordinates, at the last solved
@@ -99,27 +89,26 @@ impl Kinematics {
     /// [`first_order`](Self::first_order). `out` has n_q + n_u entries.
     pub fn transfer_transpose_times(&mut self, y: &[f64], out: &mut [f64]) {
         self.ensure_lu_at_x();
-        let mech = self.mech.clone();
-        let mut mu = std::mem::take(&mut self.rhs_vec);
-        for (k, &i) in mech.dependent.iter().enumerate() {
+        let layout = &self.layout;
+        let mu = &mut self.ws.dep;
+        for (k, &i) in self.mech.dependent.iter().enumerate() {
             mu[k] = y[i];
         }
-        self.lu.solve_transpose_vec(&mut mu);
+        self.factorization.lu.solve_transpose_vec(mu);
         out.fill(0.0);
         // nodal coordinates in ξ: their own entry minus Σ μ_r ∂D_r/∂x_i
-        for (i, k) in self.xi_of_x.iter().enumerate() {
+        for (i, k) in layout.xi_of_x.iter().enumerate() {
             if let Some(k) = k {
                 out[*k] += y[i];
             }
         }
-        self.for_each_nodal_xi_entry(|r, k, d| out[k] -= d * mu[r]);
+        layout.for_each_nodal_xi_entry(&self.jac.local, |r, k, d| out[k] -= d * mu[r]);
         // deformation coordinates in ξ: a unit entry on their row
-        for (j, k) in self.xi_of_e.iter().enumerate() {
-            if let (Some(k), Some(r)) = (k, self.row_of[j]) {
+        for (j, k) in layout.xi_of_e.iter().enumerate() {
+            if let (Some(k), Some(r)) = (k, layout.row_of[j]) {
                 out[*k] += mu[r];
             }
         }
-        self.rhs_vec = mu;
     }
 
     /// F,q V into `out` (n_x × k) for k directions of the degrees of
@@ -145,49 +134,49 @@ impl Kinematics {
         v: faer::MatRef<'_, f64>,
         mut out: faer::MatMut<'_, f64>,
     ) -> Result<(), KinematicsError> {
-        let (n_q, k) = (self.n_q, v.ncols());
+        let (n_q, k) = (self.layout.n_q, v.ncols());
+        let n_x = self.mech.n_x();
         self.check_lengths(&[
             ("the rows of V", v.nrows(), n_q),
-            ("the rows of F,q V", out.nrows(), self.mech.n_x()),
+            ("the rows of F,q V", out.nrows(), n_x),
             ("the columns of F,q V", out.ncols(), k),
         ])?;
-        if !(self.lu_valid && self.lu_at_x) {
+        if !(self.factorization.valid && self.factorization.at_x) {
             self.factor_at_x()?;
         }
-        let n_c = self.mech.constraint_rows.len();
-        if self.block.ncols() != k || self.block.nrows() != n_c {
-            self.block = Mat::zeros(n_c, k);
+        let (layout, mech, jac) = (&self.layout, &*self.mech, &self.jac.local);
+        let ws = &mut self.ws;
+        let n_c = mech.constraint_rows.len();
+        if ws.block.ncols() != k || ws.block.nrows() != n_c {
+            ws.block = Mat::zeros(n_c, k);
         }
-        let mut dir = std::mem::take(&mut self.xi_dir);
-        let mut block = std::mem::replace(&mut self.block, Mat::new());
+        let dir = &mut ws.xi_dir;
         dir[n_q..].fill(0.0);
         for c in 0..k {
             for (i, d) in dir[..n_q].iter_mut().enumerate() {
                 *d = v[(i, c)];
             }
-            self.direction_rhs(&dir, false, block.col_as_slice_mut(c));
+            layout.direction_rhs(mech, jac, None, dir, ws.block.col_as_slice_mut(c));
         }
-        self.lu.solve_in_place(block.as_mut());
+        self.factorization.lu.solve_in_place(ws.block.as_mut());
         for c in 0..k {
             for (i, d) in dir[..n_q].iter_mut().enumerate() {
                 *d = v[(i, c)];
             }
+            let dep = ws.block.col_as_slice(c);
             let dst = out.as_mut().col_mut(c);
             match dst.try_as_col_major_mut() {
-                Some(d) => self.scatter_direction(&dir, block.col_as_slice(c), d.as_slice_mut()),
+                Some(d) => layout.scatter_direction(mech, dir, dep, d.as_slice_mut()),
                 None => {
                     // (a strided destination: through the work vector)
-                    let mut w = std::mem::take(&mut self.work);
-                    self.scatter_direction(&dir, block.col_as_slice(c), &mut w[..self.mech.n_x()]);
-                    for (i, x) in w[..self.mech.n_x()].iter().enumerate() {
+                    let w = &mut ws.work[..n_x];
+                    layout.scatter_direction(mech, dir, dep, w);
+                    for (i, x) in w.iter().enumerate() {
                         out[(i, c)] = *x;
                     }
-                    self.work = w;
                 }
             }
         }
-        self.xi_dir = dir;
-        self.block = block;
         Ok(())
     }
 
@@ -195,8 +184,8 @@ impl Kinematics {
     /// deformations, at the last solved configuration).
     pub fn add_deformation_forces(&self, s: &[f64], y: &mut [f64]) {
         for (ei, e) in self.mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
+            let m = &self.layout.maps[ei];
+            let jl = &self.jac.local[ei];
             for a in 0..m.ne {
                 let v = s[e.eps_offset + a];
                 if v == 0.0 {

@@ -43,145 +43,91 @@
 #![warn(missing_docs)]
 
 mod acceleration;
+mod caches;
+mod configuration;
 mod errors;
 mod first_order;
 mod jacobian_lu;
+mod layout;
 mod null_space;
 mod position;
+mod rates;
 mod second_order;
 mod sensitivity;
 mod setup;
 mod velocity;
+mod workspace;
 
-use jacobian_lu::JacobianLu;
 pub use null_space::null_vectors;
 
 pub use errors::KinematicsError;
 pub use first_order::FirstOrderView;
 pub use position::NewtonOptions;
 
+use caches::{ElementJacobians, Factorization, FirstOrderCache};
+use configuration::Configuration;
 use faer::Mat;
 use flexmb_model::Mechanism;
+use layout::Layout;
+use position::Settings;
+use rates::Rates;
 use std::sync::Arc;
-
-struct ElemMap {
-    /// local deformation → constraint row
-    rows: Vec<Option<usize>>,
-    /// local coordinate → dependent column
-    cols: Vec<Option<usize>>,
-    nx: usize,
-    ne: usize,
-}
-
-/// An entry ∂D_r/∂x_i of a constraint row r with respect to a nodal
-/// coordinate x_i in ξ (ξ index `col`): position `local` in the element
-/// Jacobian of `element`.
-struct XiEntry {
-    row: usize,
-    col: usize,
-    element: usize,
-    local: usize,
-}
+use workspace::Workspace;
 
 /// Transfer functions and their derivatives for one mechanism; holds the
-/// current configuration and all work buffers (allocated once).
+/// current configuration, its derivatives and all work buffers (allocated
+/// once).
+///
+/// Its parts, one concern each, are crate-private types that document their
+/// invariants: the fixed `Layout` of the mechanism's constraint rows, ξ
+/// indices and maps into J (`layout.rs`); the `Settings` of the position
+/// solve (`position.rs`); the `Configuration` (t, ξ, x, ε, the branch and
+/// the last converged solution, `configuration.rs`); the derivative caches
+/// with their validity flags (`ElementJacobians`, the `Factorization` of J,
+/// the `FirstOrderCache` F,ξ and E,ξ, `caches.rs`); the `Rates`
+/// (`rates.rs`); the `Counters`; and the `Workspace` of scratch buffers
+/// (`workspace.rs`).
 pub struct Kinematics {
     mech: Arc<Mechanism>,
-    /// A stop request read at every Newton iteration of the position
-    /// solve ([`set_stop`](Self::set_stop)).
-    stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
-    opts: NewtonOptions,
-    maps: Vec<ElemMap>,
-    /// global row of each deformation (if it is an equation)
-    row_of: Vec<Option<usize>>,
-    /// ξ index of each coordinate: nodal coordinate → Some(k), deformation → Some(k)
-    xi_of_x: Vec<Option<usize>>,
-    xi_of_e: Vec<Option<usize>>,
-    /// The entries of D_c,x_ξ, the nodal columns of the right-hand side B of
-    /// (5.8a), element by element (products with directions of ξ).
-    xi_entries: Vec<XiEntry>,
-    /// The rows of J element by element, as (constraint row, (element, range
-    /// of `dep_entries`)), with `dep_entries` (dependent column, position in
-    /// the element Jacobian): products J v at the current x.
-    dep_rows: Vec<(usize, (usize, std::ops::Range<usize>))>,
-    dep_entries: Vec<(usize, usize)>,
-    length_scale: f64,
-    n_q: usize,
-    n_u: usize,
-    // state
-    t: f64,
-    xi: Vec<f64>,
-    xi_prev: Vec<f64>,
-    x: Vec<f64>,
-    eps: Vec<f64>,
-    prev_eps: Vec<f64>,
-    jac_local: Vec<Vec<f64>>,
-    /// The element Jacobians are of the current x (the last element
-    /// evaluation computed them).
-    jac_at_x: bool,
-    /// LU of J (sparse, or dense when small); `jpos[k][a·n_x,e + c]` is the position of element k's
-    /// local entry (a, c) in its values (`NO_ENTRY` when not in J).
-    lu: JacobianLu,
-    jpos: Vec<Vec<usize>>,
-    /// (element, local index) of the deformations that are not constraint rows.
-    free_deformations: Vec<(usize, usize)>,
-    f: Mat<f64>,
-    e: Mat<f64>,
-    first_order_valid: bool,
-    have_solution: bool,
-    // velocity level
-    xid: Vec<f64>,
-    /// A direction of ξ (q̈ and ü, or a direction of q) for the solves
-    /// along one.
-    xi_dir: Vec<f64>,
-    /// The right-hand sides of a block of directions
-    /// ([`transfer_matrix`](Kinematics::transfer_matrix)).
-    block: Mat<f64>,
-    xd: Vec<f64>,
-    epsd: Vec<f64>,
-    // acceleration level
-    xdd0: Vec<f64>,
-    epsdd0: Vec<f64>,
-    // scratch
-    rhs: Mat<f64>,
-    work: Vec<f64>,
-    target: Vec<f64>,
+    /// Fixed after construction.
+    layout: Layout,
+    /// Newton options and the stop flag, set by the caller.
+    settings: Settings,
+    /// t, ξ, x, ε of the last solve, the branch and the last good solution.
+    config: Configuration,
+    /// D,x of every element; `at_x` when of `config.x`.
+    jac: ElementJacobians,
+    /// The LU of J; `valid` when usable, `at_x` (implies `valid`) when of
+    /// `config.x`.
+    factorization: Factorization,
+    /// F,ξ and E,ξ; `valid` when of `config.x`.
+    first: FirstOrderCache,
+    /// ξ̇, ẋ, ε̇, ẍ0, ε̈0, D,xx\[ẋ, ẋ\] of the last rate evaluations.
+    rates: Rates,
+    /// Newton iterations, factorizations, refinements, continuations.
+    counters: Counters,
+    /// Scratch buffers (content meaningless between calls but for the
+    /// failure report's `target` and `last_update`).
+    ws: Workspace,
+}
+
+/// Cost measures of the kinematics, for the reports and the benches.
+#[derive(Clone, Copy, Debug, Default)]
+struct Counters {
+    /// Newton iterations of the last converged solve.
     iterations: usize,
-    x_good: Vec<f64>,
-    /// The first-order prediction of the current solve, for the branch
-    /// guard (`branch_jump` in position.rs).
-    x_predicted: Vec<f64>,
-    xi_good: Vec<f64>,
-    /// The target ξ = (q, u) of the current solve.
-    xi_target: Vec<f64>,
-    lu_valid: bool,
-    /// The factorization of J is of the current x (not of an earlier one).
-    lu_at_x: bool,
     /// Factorizations of J so far.
     factorizations: u64,
     /// Iterative-refinement steps of velocity solves so far.
     refinements: u64,
-    /// Refinement steps beyond the first since the last factorization.
-    extra_refinements: usize,
-    /// Solves that needed continuation from the last solution.
+    /// Solves so far that needed continuation from the last solution.
     continuations: u64,
-    dx: Vec<f64>,
-    rhs_vec: Vec<f64>,
-    last_update: Vec<f64>,
-    /// D,xx\[ẋ, ẋ\] of every deformation, after [`convective_terms`](Kinematics::convective_terms).
-    dxx_vv: Vec<f64>,
-    /// Right-hand side and residual of the refined velocity solve.
-    vel_rhs: Vec<f64>,
-    vel_res: Vec<f64>,
 }
-
-/// Marks a local Jacobian entry that is not part of J.
-const NO_ENTRY: usize = usize::MAX;
 
 impl Kinematics {
     /// The Newton settings of the position solve.
     pub fn newton_options(&self) -> NewtonOptions {
-        self.opts
+        self.settings.newton
     }
 
     /// Reads `stop` at every Newton iteration of the position solve, which
@@ -190,12 +136,12 @@ impl Kinematics {
     /// solves of iterates far from the solution. `None` (the default) never
     /// stops.
     pub fn set_stop(&mut self, stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
-        self.stop = stop;
+        self.settings.stop = stop;
     }
 
     /// Sets the Newton options.
     pub fn set_newton_options(&mut self, o: NewtonOptions) {
-        self.opts = o;
+        self.settings.newton = o;
     }
     /// The mechanism.
     pub fn mechanism(&self) -> &Arc<Mechanism> {
@@ -203,40 +149,40 @@ impl Kinematics {
     }
     /// Number of degrees of freedom.
     pub fn n_q(&self) -> usize {
-        self.n_q
+        self.layout.n_q
     }
     /// Number of prescribed inputs.
     pub fn n_u(&self) -> usize {
-        self.n_u
+        self.layout.n_u
     }
     /// Nodal coordinates of the last solve.
     pub fn x(&self) -> &[f64] {
-        &self.x
+        &self.config.x
     }
     /// Deformations of the last solve.
     pub fn eps(&self) -> &[f64] {
-        &self.eps
+        &self.config.eps
     }
     /// ξ = (q, u) of the last solve.
     pub fn xi(&self) -> &[f64] {
-        &self.xi
+        &self.config.xi
     }
     /// Newton iterations of the last solve.
     pub fn iterations(&self) -> usize {
-        self.iterations
+        self.counters.iterations
     }
     /// F,ξ (n_x × (n_q + n_u)) at the current configuration. Computed here
     /// ([`first_order`](Self::first_order)) if a solve or a new guess since
     /// the last one left it stale, so it is never of another configuration.
     pub fn f_xi(&mut self) -> &Mat<f64> {
         self.ensure_first_order();
-        &self.f
+        &self.first.f
     }
     /// E,ξ (n_ε × (n_q + n_u)) at the current configuration (see
     /// [`f_xi`](Self::f_xi)).
     pub fn e_xi(&mut self) -> &Mat<f64> {
         self.ensure_first_order();
-        &self.e
+        &self.first.e
     }
     /// The current state with F,ξ and E,ξ of the current configuration
     /// (computed first if stale, see [`f_xi`](Self::f_xi)), for reading them
@@ -244,59 +190,59 @@ impl Kinematics {
     pub fn first_order_view(&mut self) -> FirstOrderView<'_> {
         self.ensure_first_order();
         FirstOrderView {
-            x: &self.x,
-            eps: &self.eps,
-            xd: &self.xd,
-            epsd: &self.epsd,
-            xdd0: &self.xdd0,
-            f: &self.f,
-            e: &self.e,
+            x: &self.config.x,
+            eps: &self.config.eps,
+            xd: &self.rates.xd,
+            epsd: &self.rates.epsd,
+            xdd0: &self.rates.xdd0,
+            f: &self.first.f,
+            e: &self.first.e,
         }
     }
     /// Whether F,ξ and E,ξ are of the current configuration (else the next
     /// read computes them).
     pub fn first_order_is_current(&self) -> bool {
-        self.first_order_valid
+        self.first.valid
     }
     fn ensure_first_order(&mut self) {
-        if !self.first_order_valid {
+        if !self.first.valid {
             self.first_order();
         }
     }
     /// ẋ of the last [`velocities`](Self::velocities) call.
     pub fn xd(&self) -> &[f64] {
-        &self.xd
+        &self.rates.xd
     }
     /// ε̇ of the last [`velocities`](Self::velocities) call.
     pub fn epsd(&self) -> &[f64] {
-        &self.epsd
+        &self.rates.epsd
     }
     /// ẍ for q̈ = 0: F,u ü + (F,ξξ ξ̇)ξ̇, after [`accelerations`](Self::accelerations).
     pub fn xdd0(&self) -> &[f64] {
-        &self.xdd0
+        &self.rates.xdd0
     }
     /// ε̈ for q̈ = 0, after [`accelerations`](Self::accelerations).
     pub fn epsdd0(&self) -> &[f64] {
-        &self.epsdd0
+        &self.rates.epsdd0
     }
     /// D,xx\[ẋ, ẋ\] of every deformation, from the last
     /// [`convective_terms`](Self::convective_terms) call.
     pub fn convective(&self) -> &[f64] {
-        &self.dxx_vv
+        &self.rates.dxx_vv
     }
     /// The local deformation Jacobian D,x of element `k` (row-major), at the last solve.
     pub fn element_jacobian(&self, k: usize) -> &[f64] {
-        &self.jac_local[k]
+        &self.jac.local[k]
     }
 
     /// Overrides the current configuration (e.g. a previously converged state)
     /// as the starting guess of the next solve.
     pub fn set_guess(&mut self, x: &[f64]) {
-        self.x.copy_from_slice(x);
-        self.jac_at_x = false;
-        self.have_solution = false;
-        self.lu_at_x = false;
-        self.first_order_valid = false;
+        self.config.x.copy_from_slice(x);
+        self.config.solved = false;
+        self.jac.at_x = false;
+        self.factorization.at_x = false;
+        self.first.valid = false;
     }
 
     /// The smallest over the largest pivot of the last LU factorization of
@@ -308,8 +254,8 @@ impl Kinematics {
     /// reading it changes nothing. Its value depends on the units of the
     /// rows and columns: only its ratio to an earlier value means something.
     pub fn pivot_ratio(&self) -> f64 {
-        if self.lu_valid {
-            self.lu.pivot_ratio
+        if self.factorization.valid {
+            self.factorization.lu.pivot_ratio
         } else {
             0.0
         }
@@ -319,7 +265,7 @@ impl Kinematics {
     /// periodic deformations (hinge angles over many turns) are continued
     /// from in the next solve.
     pub fn branch(&self) -> &[f64] {
-        &self.prev_eps
+        &self.config.branch
     }
 
     /// Continues periodic deformations from `eps` (the [`branch`](Self::branch)
@@ -327,24 +273,24 @@ impl Kinematics {
     /// another chart) in the next solve: a new kinematics would otherwise
     /// unwrap a hinge angle against zero, not against the turns it has made.
     pub fn set_branch(&mut self, eps: &[f64]) {
-        self.prev_eps.copy_from_slice(eps);
+        self.config.branch.copy_from_slice(eps);
     }
 
     /// Factorizations of the kinematic Jacobian so far (a cost measure).
     pub fn factorizations(&self) -> u64 {
-        self.factorizations
+        self.counters.factorizations
     }
 
     /// Iterative-refinement steps of [`velocities_refined`](Self::velocities_refined)
     /// so far (each one product with J and one solve).
     pub fn refinements(&self) -> u64 {
-        self.refinements
+        self.counters.refinements
     }
 
     /// Solves so far whose first Newton solve failed and that continued from
     /// the last solution in equal steps of ξ.
     pub fn continuations(&self) -> u64 {
-        self.continuations
+        self.counters.continuations
     }
 
     /// `Ok` if every (name, length, needed) has its length, else the

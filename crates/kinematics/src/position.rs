@@ -3,8 +3,10 @@
 //! first-order predictor, chord steps on a kept factorization of J and
 //! continuation from the last solution.
 
-use crate::{Kinematics, KinematicsError, NO_ENTRY};
+use crate::{Kinematics, KinematicsError};
 use flexmb_model::{ERole, XRole};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// A residual within this many ε·max|x| is at the rounding level of the
 /// coordinates it is computed from (a difference of two coordinates of size
@@ -51,6 +53,16 @@ impl Default for NewtonOptions {
     }
 }
 
+/// The settings of the position solve.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Settings {
+    /// Newton's tolerance and iteration limit.
+    pub(crate) newton: NewtonOptions,
+    /// A stop request read at every Newton iteration
+    /// ([`Kinematics::set_stop`]).
+    pub(crate) stop: Option<Arc<AtomicBool>>,
+}
+
 /// When the position solve factorizes the kinematic Jacobian at the
 /// converged configuration.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -67,26 +79,26 @@ impl Kinematics {
     /// Jacobians D,x if `with_jac` (dual numbers: several times the cost of
     /// ε alone for a spatial beam, which Newton's trial steps need only).
     pub(crate) fn eval_elements(&mut self, with_jac: bool) {
-        self.jac_at_x = with_jac;
-        let mech = &self.mech;
+        self.jac.at_x = with_jac;
+        let config = &mut self.config;
         let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
-        for (k, e) in mech.elements.iter().enumerate() {
-            let m = &self.maps[k];
+        for (k, e) in self.mech.elements.iter().enumerate() {
+            let m = &self.layout.maps[k];
             if m.ne == 0 {
                 continue;
             }
             for (c, gi) in e.x_index.iter().enumerate() {
-                xl[c] = self.x[*gi];
+                xl[c] = config.x[*gi];
             }
             let o = e.eps_offset;
-            let prev = &self.prev_eps[o..o + m.ne];
-            let out = &mut self.eps[o..o + m.ne];
+            let prev = &config.branch[o..o + m.ne];
+            let out = &mut config.eps[o..o + m.ne];
             if with_jac {
                 e.element.deformations_and_jacobian(
                     &xl[..m.nx],
                     Some(prev),
                     out,
-                    &mut self.jac_local[k],
+                    &mut self.jac.local[k],
                 );
             } else {
                 e.element.deformations(&xl[..m.nx], Some(prev), out);
@@ -111,11 +123,11 @@ impl Kinematics {
             let Some(&dep) = o.iter().find(is_dep) else {
                 continue;
             };
-            if deps == 1 && dofs == 3 && self.x[dep].abs() < 0.05 {
+            if deps == 1 && dofs == 3 && self.config.x[dep].abs() < 0.05 {
                 return Err(KinematicsError::EulerParameterDegenerate {
                     node: n.id.clone(),
                     coordinate: self.mech.x_names[dep].clone(),
-                    value: self.x[dep],
+                    value: self.config.x[dep],
                 });
             }
         }
@@ -127,7 +139,7 @@ impl Kinematics {
             .constraint_rows
             .iter()
             .enumerate()
-            .map(|(r, j)| (self.eps[*j] - self.target[r]).abs())
+            .map(|(r, j)| (self.config.eps[*j] - self.ws.target[r]).abs())
             .fold(0.0f64, f64::max)
     }
 
@@ -135,21 +147,8 @@ impl Kinematics {
     /// evaluation was of ε only (ε does not change: the plain and the dual
     /// evaluation give it bit for bit alike).
     fn ensure_jacobians(&mut self) {
-        if !self.jac_at_x {
+        if !self.jac.at_x {
             self.eval_elements(true);
-        }
-    }
-
-    /// Scatters the element Jacobians into the values of J.
-    fn assemble_jacobian(&mut self) {
-        let values = self.lu.values_mut();
-        values.fill(0.0);
-        for (jl, pos) in self.jac_local.iter().zip(&self.jpos) {
-            for (v, &p) in jl.iter().zip(pos) {
-                if p != NO_ENTRY {
-                    values[p] += v;
-                }
-            }
         }
     }
 
@@ -175,8 +174,9 @@ impl Kinematics {
         let r = self.solve_inner(q, t, mode);
         match &r {
             Ok(()) => {
-                self.x_good.copy_from_slice(&self.x);
-                self.xi_good.copy_from_slice(&self.xi);
+                let c = &mut self.config;
+                c.x_good.copy_from_slice(&c.x);
+                c.xi_good.copy_from_slice(&c.xi);
             }
             // back to the last converged configuration: the next solve
             // (e.g. a retried, smaller step) starts from a good guess
@@ -190,20 +190,21 @@ impl Kinematics {
     /// factorization (the last one may be of a configuration far off, and
     /// must neither pass for one at x nor predict from it).
     fn restore_last_solution(&mut self) {
-        self.x.copy_from_slice(&self.x_good);
-        self.xi.copy_from_slice(&self.xi_good);
-        self.have_solution = true;
-        self.first_order_valid = false;
-        self.lu_valid = false;
-        self.lu_at_x = false;
+        let c = &mut self.config;
+        c.x.copy_from_slice(&c.x_good);
+        c.xi.copy_from_slice(&c.xi_good);
+        c.solved = true;
+        self.first.valid = false;
+        self.factorization.invalidate();
         self.eval_elements(true);
     }
 
     fn solve_inner(&mut self, q: &[f64], t: f64, mode: Refactor) -> Result<(), KinematicsError> {
-        if q.len() != self.n_q {
+        let (n_q, n_u) = (self.layout.n_q, self.layout.n_u);
+        if q.len() != n_q {
             return Err(KinematicsError::Length {
                 what: "q",
-                expected: self.n_q,
+                expected: n_q,
                 got: q.len(),
             });
         }
@@ -216,50 +217,45 @@ impl Kinematics {
                 name: flexmb_model::list_some(&bad, |k| self.mech.dof_label(k)),
             });
         }
-        // ξ = (q, u) in a buffer kept between solves (no allocation per solve)
-        let mut target = std::mem::take(&mut self.xi_target);
-        target[..self.n_q].copy_from_slice(q);
-        for k in 0..self.n_u {
-            target[self.n_q + k] = self.mech.inputs[k].function.value(t);
+        // the target ξ = (q, u), in a buffer kept between solves (no
+        // allocation per solve)
+        let target = &mut self.ws.xi_target;
+        target[..n_q].copy_from_slice(q);
+        for k in 0..n_u {
+            target[n_q + k] = self.mech.inputs[k].function.value(t);
         }
-        self.t = t;
-        let r = self.solve_to(&target, mode);
-        self.xi_target = target;
-        r
+        self.config.t = t;
+        self.solve_to(mode)
     }
 
-    /// [`solve_inner`](Self::solve_inner) for the full target ξ: one Newton
-    /// solve, then a continuation from the last converged ξ if that fails.
-    fn solve_to(&mut self, target: &[f64], mode: Refactor) -> Result<(), KinematicsError> {
-        let first = self.solve_xi(target, mode, BRANCH_RATIO);
+    /// [`solve_inner`](Self::solve_inner) for the full target ξ in
+    /// `ws.xi_target`: one Newton solve, then a continuation from the last
+    /// converged ξ if that fails.
+    fn solve_to(&mut self, mode: Refactor) -> Result<(), KinematicsError> {
+        self.step_xi(None);
+        let first = self.solve_xi(mode, BRANCH_RATIO);
         if first.is_ok() || matches!(first, Err(KinematicsError::EulerParameterDegenerate { .. })) {
             return first;
         }
         // continuation from the last converged configuration: reach the target
         // in 2, 4, …, 64 equal steps of ξ (large jumps, e.g. a first solve far
-        // from the reference configuration)
-        self.continuations += 1;
-        let start = self.xi_good.clone();
+        // from the reference configuration, or a step the branch guard
+        // refused)
+        self.counters.continuations += 1;
         let mut err = first;
         for n in [2usize, 4, 8, 16, 32, FINEST_STEPS] {
             self.restore_last_solution();
             let mut ok = true;
             for j in 1..=n {
-                let s = j as f64 / n as f64;
-                // (the last step to the target itself, not to a rounding of it)
-                let mid: Vec<f64> = start
-                    .iter()
-                    .zip(target)
-                    .map(|(a, b)| if j == n { *b } else { a + s * (b - a) })
-                    .collect();
+                self.step_xi(Some(j as f64 / n as f64));
                 // J factorized at each intermediate solution: the next
-                // step's chord predictor is of first order along the step
-                // in the finest steps, a correction up to the predicted
+                // step's chord predictor is of first order along the step.
+                // In the finest steps, a correction up to the predicted
                 // motion itself is accepted: near a fold of the branch (a
                 // configuration at the edge of reach) the ratio grows as
-                // 1/distance to the fold however small the steps
+                // 1/distance to the fold however small the steps.
                 let ratio = if n == FINEST_STEPS { 1.0 } else { BRANCH_RATIO };
-                match self.solve_xi(&mid, Refactor::AtSolution, ratio) {
+                match self.solve_xi(Refactor::AtSolution, ratio) {
                     Ok(()) => {}
                     // the chart's limit: smaller steps do not pass it
                     Err(e @ KinematicsError::EulerParameterDegenerate { .. }) => return Err(e),
@@ -277,59 +273,68 @@ impl Kinematics {
         err
     }
 
-    /// One Newton solve for the full ξ = (q, u).
+    /// Sets the ξ of the next Newton solve, keeping the current one as
+    /// `xi_prev`: the target `ws.xi_target`, or with `Some(s)` the point a
+    /// fraction s of the way to it from the last converged ξ (continuation;
+    /// `xi_good` does not change while the continuation runs).
+    fn step_xi(&mut self, s: Option<f64>) {
+        let c = &mut self.config;
+        c.xi_prev.copy_from_slice(&c.xi);
+        let target = &self.ws.xi_target;
+        match s {
+            None => c.xi.copy_from_slice(target),
+            // (the last step to the target itself, not to a rounding of it)
+            Some(s) if s == 1.0 => c.xi.copy_from_slice(target),
+            Some(s) => {
+                for ((xi, a), b) in c.xi.iter_mut().zip(&c.xi_good).zip(target) {
+                    *xi = a + s * (b - a);
+                }
+            }
+        }
+    }
+
+    /// One Newton solve for the ξ = (q, u) that
+    /// [`step_xi`](Self::step_xi) set.
     ///
     /// Chord Newton: the factorization of J is kept from step to step (and
     /// from the previous solve) while the residual shrinks at least tenfold
     /// per step, and refactorized at the current x otherwise. With
     /// [`Refactor::AtSolution`] J is also factorized at the converged point
     /// (F,ξ needs it there); with [`Refactor::WhenSlow`] the last factorization
-    /// may be of a nearby configuration, and `lu_at_x` says whether it is not.
-    ///
-    /// The branch guard ([`branch_jump`](Self::branch_jump)) refuses a
-    /// solution whose Newton corrections exceed `branch_ratio` times the
-    /// prediction's motion.
-    fn solve_xi(
-        &mut self,
-        xi: &[f64],
-        mode: Refactor,
-        branch_ratio: f64,
-    ) -> Result<(), KinematicsError> {
-        let n_q = self.n_q;
-        self.xi_prev.copy_from_slice(&self.xi);
-        self.xi.copy_from_slice(xi);
-        // targets of the constraint rows
-        for (r, j) in self.mech.constraint_rows.iter().enumerate() {
-            self.target[r] = match self.mech.e_roles[*j] {
-                ERole::Dof(k) => self.xi[k],
-                ERole::Input(k) => self.xi[n_q + k],
-                _ => 0.0,
-            };
-        }
+    /// may be of a nearby configuration, and `Factorization::at_x` says whether
+    /// it is not.
+    fn solve_xi(&mut self, mode: Refactor, branch_ratio: f64) -> Result<(), KinematicsError> {
+        let n_q = self.layout.n_q;
+        self.set_row_targets();
         // the branch guard compares the solution with the prediction from
         // the last solution (not with a guess of `set_guess`)
-        let guard = self.have_solution;
-        if guard && !self.first_order_valid && !self.lu_valid && self.xi != self.xi_prev {
+        let guard = self.config.solved;
+        if guard
+            && !self.first.valid
+            && !self.factorization.valid
+            && self.config.xi != self.config.xi_prev
+        {
             // no derivative at hand (the reference, or a restored solution):
             // factorize J there for the chord predictor (a singular J
             // leaves none: the guard then compares with the unpredicted x)
             let _ = self.factor_at_x();
         }
         if guard {
-            self.x_predicted.copy_from_slice(&self.x);
+            self.ws.x_predicted.copy_from_slice(&self.config.x);
         }
-        let mut moved = self.have_solution && self.predict();
-        self.first_order_valid = false;
+        let mut moved = self.config.solved && self.predict();
+        self.first.valid = false;
         // known coordinates
+        let c = &mut self.config;
         for (i, r) in self.mech.x_roles.iter().enumerate() {
             let v = match r {
                 XRole::Fixed => self.mech.x0[i],
-                XRole::Dof(k) => self.xi[*k],
-                XRole::Input(k) => self.xi[n_q + k],
+                XRole::Dof(k) => c.xi[*k],
+                XRole::Input(k) => c.xi[n_q + k],
                 XRole::Dependent(_) => continue,
             };
-            if self.x[i] != v {
-                self.x[i] = v;
+            if c.x[i] != v {
+                c.x[i] = v;
                 moved = true;
             }
         }
@@ -337,31 +342,31 @@ impl Kinematics {
         // predicted configuration
         let mut predicted = 0.0f64;
         if guard {
-            for (p, x) in self.x_predicted.iter_mut().zip(&self.x) {
+            for (p, x) in self.ws.x_predicted.iter_mut().zip(&c.x) {
                 predicted = predicted.max((x - *p).abs());
                 *p = *x;
             }
         }
         if moved {
-            self.lu_at_x = false;
+            self.factorization.at_x = false;
         }
-        let tol = self.opts.tol * self.length_scale.max(1e-6);
+        let newton = self.settings.newton;
+        let tol = newton.tol * self.layout.length_scale.max(1e-6);
         let n_c = self.mech.constraint_rows.len();
-        let mut last_update = std::mem::take(&mut self.last_update);
-        last_update.fill(0.0);
-        let mut lu_fresh_for_steps = self.lu_valid;
+        self.ws.last_update.fill(0.0);
+        let mut lu_fresh_for_steps = self.factorization.valid;
         let mut prev_res = f64::INFINITY;
         // ε only; the Jacobians where J is factorized and at the solution
         self.eval_elements(false);
         let mut res = self.load_residual();
         let mut outcome = None;
-        for it in 0..=self.opts.max_iterations {
+        for it in 0..=newton.max_iterations {
             if self
+                .settings
                 .stop
                 .as_ref()
-                .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+                .is_some_and(|s| s.load(Ordering::Relaxed))
             {
-                self.last_update = last_update;
                 return Err(KinematicsError::Interrupted);
             }
             if !res.is_finite() {
@@ -373,13 +378,17 @@ impl Kinematics {
                 .mech
                 .dependent
                 .iter()
-                .fold(1.0f64, |m, &i| m.max(self.x[i].abs()));
+                .fold(1.0f64, |m, &i| m.max(self.config.x[i].abs()));
             // (the residual of a length cannot be computed more accurately than
             // the rounding of the coordinates it is computed from: a mechanism
             // far from the origin, or large against its elements, stalls
             // there, however small tol · L is)
             let stalled = it > 0
-                && last_update.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+                && self
+                    .ws
+                    .last_update
+                    .iter()
+                    .fold(0.0f64, |m, v| m.max(v.abs()))
                     <= 8.0 * f64::EPSILON * x_scale
                 && res <= (1e3 * tol).max(ROUNDING_RESIDUALS * f64::EPSILON * x_scale);
             if res <= tol || stalled {
@@ -394,7 +403,7 @@ impl Kinematics {
                 });
                 break;
             }
-            if it == self.opts.max_iterations {
+            if it == newton.max_iterations {
                 break;
             }
             // a fresh factorization at this x: without a usable one, or when
@@ -407,8 +416,9 @@ impl Kinematics {
                 lu_fresh_for_steps = true;
             }
             prev_res = res;
-            self.dx[..n_c].copy_from_slice(&self.work[..n_c]);
-            self.lu.solve_vec(&mut self.dx[..n_c]);
+            let ws = &mut self.ws;
+            ws.dx[..n_c].copy_from_slice(&ws.work[..n_c]);
+            self.factorization.lu.solve_vec(&mut ws.dx[..n_c]);
             // step with backtracking: halve while the residual grows; the trial
             // evaluation (with Jacobians) serves the next iteration
             let mut step = 1.0;
@@ -423,50 +433,61 @@ impl Kinematics {
                 self.add_to_dependent(-step);
                 step *= 0.5;
             }
-            self.lu_at_x = false;
-            for (u, d) in last_update.iter_mut().zip(&self.dx) {
+            self.factorization.at_x = false;
+            let ws = &mut self.ws;
+            for (u, d) in ws.last_update.iter_mut().zip(&ws.dx) {
                 *u = d * step;
             }
             res = self.load_residual();
         }
-        let result = match outcome {
+        match outcome {
             Some(r) => r,
-            None => Err(self.not_converged(&last_update)),
-        };
-        self.last_update = last_update;
-        result
+            None => Err(self.not_converged()),
+        }
+    }
+
+    /// The targets of the constraint rows for the current ξ: 0 for the
+    /// rigid deformations, the DOF's or input's value for theirs.
+    pub(crate) fn set_row_targets(&mut self) {
+        let (n_q, xi) = (self.layout.n_q, &self.config.xi);
+        for (r, j) in self.mech.constraint_rows.iter().enumerate() {
+            self.ws.target[r] = match self.mech.e_roles[*j] {
+                ERole::Dof(k) => xi[k],
+                ERole::Input(k) => xi[n_q + k],
+                _ => 0.0,
+            };
+        }
     }
 
     /// The [`KinematicsError::BranchJump`] of a converged Newton solve whose
     /// corrections moved a dependent coordinate from the first-order
-    /// prediction by more than `ratio` times the largest motion of
-    /// the prediction (`predicted`, the known coordinates' included): along
-    /// a smooth branch the correction is of second order in the step and the
-    /// prediction of first order, so this happens for steps too large for the
-    /// branch's curvature, and when Newton lands on another branch of the
-    /// constraint equations (an elbow folded the other way). Corrections
+    /// prediction by more than `ratio` times the largest motion of the
+    /// prediction (`predicted`, the known coordinates' included): along a
+    /// smooth branch the correction is of second order in the step and the
+    /// prediction of first order, so this happens for steps too large for
+    /// the branch's curvature, and when Newton lands on another branch of
+    /// the constraint equations (an elbow folded the other way). Corrections
     /// within [`BRANCH_NOISE`] of the length scale are never a jump.
     fn branch_jump(&self, predicted: f64, ratio: f64) -> Option<KinematicsError> {
         let (mut correction, mut at) = (0.0f64, 0);
         for &i in &self.mech.dependent {
-            let c = (self.x[i] - self.x_predicted[i]).abs();
+            let c = (self.config.x[i] - self.ws.x_predicted[i]).abs();
             if c > correction {
                 (correction, at) = (c, i);
             }
         }
-        (correction > ratio * predicted && correction > BRANCH_NOISE * self.length_scale).then(
-            || KinematicsError::BranchJump {
+        (correction > ratio * predicted && correction > BRANCH_NOISE * self.layout.length_scale)
+            .then(|| KinematicsError::BranchJump {
                 coordinate: self.mech.x_names[at].clone(),
                 correction,
                 predicted,
-            },
-        )
+            })
     }
 
     /// x_dep += s · dx.
     fn add_to_dependent(&mut self, s: f64) {
         for (k, &i) in self.mech.dependent.iter().enumerate() {
-            self.x[i] += s * self.dx[k];
+            self.config.x[i] += s * self.ws.dx[k];
         }
     }
 
@@ -474,8 +495,8 @@ impl Kinematics {
     fn load_residual(&mut self) -> f64 {
         let mut res = 0.0f64;
         for (r, j) in self.mech.constraint_rows.iter().enumerate() {
-            let v = self.eps[*j] - self.target[r];
-            self.work[r] = -v;
+            let v = self.config.eps[*j] - self.ws.target[r];
+            self.ws.work[r] = -v;
             res = res.max(v.abs());
         }
         res
@@ -484,29 +505,31 @@ impl Kinematics {
     /// Bookkeeping of a converged solve (and the factorization `mode` asks for).
     fn converged(&mut self, it: usize, mode: Refactor) -> Result<(), KinematicsError> {
         self.ensure_jacobians();
-        if mode == Refactor::AtSolution && !self.lu_at_x {
+        if mode == Refactor::AtSolution && !self.factorization.at_x {
             self.factor_at_x()?;
         }
         self.check_euler_parameters()?;
-        self.iterations = it;
-        self.prev_eps.copy_from_slice(&self.eps);
-        self.have_solution = true;
+        self.counters.iterations = it;
+        let c = &mut self.config;
+        c.branch.copy_from_slice(&c.eps);
+        c.solved = true;
         Ok(())
     }
 
     /// Factorizes J at the current x (element Jacobians evaluated there).
     pub(crate) fn factor_at_x(&mut self) -> Result<(), KinematicsError> {
         self.ensure_jacobians();
-        self.assemble_jacobian();
-        self.factorizations += 1;
-        self.extra_refinements = 0;
-        if !self.lu.factor() {
-            self.lu_valid = false;
-            self.lu_at_x = false;
+        let f = &mut self.factorization;
+        self.layout
+            .assemble_jacobian(&self.jac.local, f.lu.values_mut());
+        self.counters.factorizations += 1;
+        f.extra_refinements = 0;
+        if !f.lu.factor() {
+            f.invalidate();
             return Err(self.singular_error());
         }
-        self.lu_valid = true;
-        self.lu_at_x = true;
+        f.valid = true;
+        f.at_x = true;
         Ok(())
     }
 
@@ -516,34 +539,36 @@ impl Kinematics {
     /// factorization and the element Jacobians of the last solution (the same
     /// step to first order). Returns whether x changed.
     fn predict(&mut self) -> bool {
-        let n_xi = self.n_q + self.n_u;
+        let c = &mut self.config;
         let mut moved = false;
-        if self.first_order_valid {
-            for c in 0..n_xi {
-                let d = self.xi[c] - self.xi_prev[c];
+        if self.first.valid {
+            for k in 0..self.layout.n_xi() {
+                let d = c.xi[k] - c.xi_prev[k];
                 if d != 0.0 {
                     moved = true;
                     for &i in &self.mech.dependent {
-                        self.x[i] += self.f[(i, c)] * d;
+                        c.x[i] += self.first.f[(i, k)] * d;
                     }
                 }
             }
             return moved;
         }
-        if !self.lu_valid || self.xi == self.xi_prev {
+        if !self.factorization.valid || c.xi == c.xi_prev {
             return false;
         }
-        let mut rhs = std::mem::take(&mut self.dx);
+        let rhs = &mut self.ws.dx;
         for (r, j) in self.mech.constraint_rows.iter().enumerate() {
-            rhs[r] = self.target[r] - self.eps[*j];
+            rhs[r] = self.ws.target[r] - c.eps[*j];
         }
-        let (xi, xi_prev) = (&self.xi, &self.xi_prev);
-        self.for_each_nodal_xi_entry(|r, k, d| rhs[r] -= d * (xi[k] - xi_prev[k]));
-        self.lu.solve_vec(&mut rhs);
+        let (xi, xi_prev) = (&c.xi, &c.xi_prev);
+        self.layout
+            .for_each_nodal_xi_entry(&self.jac.local, |r, k, d| {
+                rhs[r] -= d * (xi[k] - xi_prev[k])
+            });
+        self.factorization.lu.solve_vec(rhs);
         for (k, &i) in self.mech.dependent.iter().enumerate() {
-            self.x[i] += rhs[k];
+            c.x[i] += rhs[k];
         }
-        self.dx = rhs;
         true
     }
 
@@ -551,7 +576,7 @@ impl Kinematics {
     /// another one (after [`solve_chord`](Self::solve_chord)). A singular J
     /// leaves the factorization invalid and every later solve NaN.
     pub(crate) fn ensure_lu_at_x(&mut self) {
-        if self.have_solution && !self.lu_at_x {
+        if self.config.solved && !self.factorization.at_x {
             let _ = self.factor_at_x();
         }
     }

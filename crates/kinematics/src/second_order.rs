@@ -36,8 +36,8 @@ impl Kinematics {
     fn weighted_hessian_times_f(&mut self, w: &[f64], sigma: &[f64]) -> Mat<f64> {
         self.ensure_lu_at_x();
         self.ensure_first_order();
-        let mech = self.mech.clone();
-        let n_q = self.n_q;
+        let mech = &*self.mech;
+        let n_q = self.layout.n_q;
         let n_c = mech.constraint_rows.len();
         // y = w + D,xᵀ σ_dep on the dependent coordinates
         let mut y = vec![0.0; n_c];
@@ -45,11 +45,11 @@ impl Kinematics {
             y[k] = w[i];
         }
         for (ei, e) in mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
+            let m = &self.layout.maps[ei];
+            let jl = &self.jac.local[ei];
             for a in 0..m.ne {
                 let j = e.eps_offset + a;
-                if self.row_of[j].is_some() || sigma[j] == 0.0 {
+                if self.layout.row_of[j].is_some() || sigma[j] == 0.0 {
                     continue;
                 }
                 for (cc, col) in m.cols.iter().enumerate() {
@@ -59,7 +59,7 @@ impl Kinematics {
                 }
             }
         }
-        self.lu.solve_transpose_vec(&mut y);
+        self.factorization.lu.solve_transpose_vec(&mut y);
         let mu = y;
         // HF = Σ_e scatter(H_e F_e), then G = F,qᵀ HF with one product
         let n_x = mech.n_x();
@@ -70,14 +70,14 @@ impl Kinematics {
             vec![0.0; flexmb_element::MAX_ELEMENT_COORDS * flexmb_element::MAX_ELEMENT_COORDS];
         let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
+            let m = &self.layout.maps[ei];
             if m.ne == 0 {
                 continue;
             }
             let mut any = false;
             for a in 0..m.ne {
                 let j = e.eps_offset + a;
-                wl[a] = match self.row_of[j] {
+                wl[a] = match self.layout.row_of[j] {
                     Some(r) => -mu[r],
                     None => sigma[j],
                 };
@@ -87,13 +87,13 @@ impl Kinematics {
                 continue;
             }
             for (k, gi) in e.x_index.iter().enumerate() {
-                xl[k] = self.x[*gi];
+                xl[k] = self.config.x[*gi];
             }
             let nx = m.nx;
             e.element
                 .deformation_weighted_hessian(&xl[..nx], &wl[..m.ne], &mut h[..nx * nx]);
             for c in 0..n_q {
-                let fcol = self.f.col_as_slice(c);
+                let fcol = self.first.f.col_as_slice(c);
                 let mut nz = false;
                 for (a, gi) in e.x_index.iter().enumerate() {
                     fl[a] = fcol[*gi];
@@ -119,7 +119,7 @@ impl Kinematics {
     /// G = F,qᵀ HF, symmetric, for HF of
     /// [`weighted_hessian_times_f`](Self::weighted_hessian_times_f).
     fn contract_with_f(&self, hf: &Mat<f64>) -> Mat<f64> {
-        let n_q = self.n_q;
+        let n_q = self.layout.n_q;
         // G is symmetric (each H_e is): only its lower triangle is computed,
         // half the cost of the dense product (the bulk of a linearization of
         // a large model: 0.28 s of 0.46 s for the 1440-DOF flexure chain),
@@ -130,7 +130,7 @@ impl Kinematics {
             g.as_mut(),
             BlockStructure::TriangularLower,
             faer::Accum::Replace,
-            self.f.subcols(0, n_q).transpose(),
+            self.first.f.subcols(0, n_q).transpose(),
             BlockStructure::Rectangular,
             hf.as_ref(),
             BlockStructure::Rectangular,

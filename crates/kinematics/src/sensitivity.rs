@@ -13,14 +13,14 @@ impl Kinematics {
     pub fn velocity_sensitivity(&mut self) -> (Mat<f64>, Mat<f64>) {
         self.ensure_lu_at_x();
         self.ensure_first_order();
-        let mech = self.mech.clone();
-        let (n_q, n_x, n_e) = (self.n_q, mech.n_x(), mech.n_eps());
+        let mech = &*self.mech;
+        let (n_q, n_x, n_e) = (self.layout.n_q, mech.n_x(), mech.n_eps());
         let n_c = mech.constraint_rows.len();
         // c_k = D,xx[F e_k, ẋ] for every deformation
         let mut c = Mat::<f64>::zeros(n_e, n_q);
-        self.directional_second(&mut c, |_, _| None);
+        self.directional_second(&mut c);
         let mut rhs = Mat::from_fn(n_c, n_q, |r, k| -c[(mech.constraint_rows[r], k)]);
-        self.lu.solve_in_place(rhs.as_mut());
+        self.factorization.lu.solve_in_place(rhs.as_mut());
         let mut x1 = Mat::<f64>::zeros(n_x, n_q);
         for k in 0..n_q {
             for (r, &i) in mech.dependent.iter().enumerate() {
@@ -31,7 +31,7 @@ impl Kinematics {
         let mut ed = c;
         self.add_jacobian_times(&x1, &mut ed);
         for j in 0..n_e {
-            if self.row_of[j].is_some() {
+            if self.layout.row_of[j].is_some() {
                 for k in 0..n_q {
                     ed[(j, k)] = 0.0;
                 }
@@ -46,8 +46,8 @@ impl Kinematics {
     pub fn acceleration_sensitivity(&mut self, xdd: &[f64], x1: &Mat<f64>) -> Mat<f64> {
         self.ensure_lu_at_x();
         self.ensure_first_order();
-        let mech = self.mech.clone();
-        let (n_q, n_x) = (self.n_q, mech.n_x());
+        let mech = &*self.mech;
+        let (n_q, n_x) = (self.layout.n_q, mech.n_x());
         let n_c = mech.constraint_rows.len();
         let mut rhs = Mat::<f64>::zeros(n_c, n_q);
         let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
@@ -59,19 +59,19 @@ impl Kinematics {
         let mut o2 = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         let mut o3 = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
+            let m = &self.layout.maps[ei];
             if m.ne == 0 || m.rows.iter().all(|r| r.is_none()) {
                 continue;
             }
             for (a, gi) in e.x_index.iter().enumerate() {
-                xl[a] = self.x[*gi];
-                vl[a] = self.xd[*gi];
+                xl[a] = self.config.x[*gi];
+                vl[a] = self.rates.xd[*gi];
                 al[a] = xdd[*gi];
             }
             for k in 0..n_q {
                 let mut any = false;
                 for (a, gi) in e.x_index.iter().enumerate() {
-                    fl[a] = self.f[(*gi, k)];
+                    fl[a] = self.first.f[(*gi, k)];
                     gl[a] = x1[(*gi, k)];
                     any |= fl[a] != 0.0 || gl[a] != 0.0;
                 }
@@ -105,7 +105,7 @@ impl Kinematics {
                 }
             }
         }
-        self.lu.solve_in_place(rhs.as_mut());
+        self.factorization.lu.solve_in_place(rhs.as_mut());
         let mut x2 = Mat::<f64>::zeros(n_x, n_q);
         for k in 0..n_q {
             for (r, &i) in mech.dependent.iter().enumerate() {
@@ -119,8 +119,8 @@ impl Kinematics {
     fn add_jacobian_times(&self, cols: &Mat<f64>, out: &mut Mat<f64>) {
         let n_k = cols.ncols();
         for (ei, e) in self.mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
-            let jl = &self.jac_local[ei];
+            let m = &self.layout.maps[ei];
+            let jl = &self.jac.local[ei];
             for a in 0..m.ne {
                 let j = e.eps_offset + a;
                 for k in 0..n_k {
@@ -135,25 +135,21 @@ impl Kinematics {
     }
 
     /// out(j, k) = D_j,xx\[F,q e_k, ẋ\] for every deformation.
-    fn directional_second(
-        &self,
-        out: &mut Mat<f64>,
-        _unused: impl Fn(usize, usize) -> Option<f64>,
-    ) {
-        let n_q = self.n_q;
+    fn directional_second(&self, out: &mut Mat<f64>) {
+        let n_q = self.layout.n_q;
         let mut xl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         let mut vl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         let mut fl = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         let mut o = [0.0; flexmb_element::MAX_ELEMENT_COORDS];
         for (ei, e) in self.mech.elements.iter().enumerate() {
-            let m = &self.maps[ei];
+            let m = &self.layout.maps[ei];
             if m.ne == 0 {
                 continue;
             }
             let mut moving = false;
             for (a, gi) in e.x_index.iter().enumerate() {
-                xl[a] = self.x[*gi];
-                vl[a] = self.xd[*gi];
+                xl[a] = self.config.x[*gi];
+                vl[a] = self.rates.xd[*gi];
                 moving |= vl[a] != 0.0;
             }
             if !moving {
@@ -162,7 +158,7 @@ impl Kinematics {
             for k in 0..n_q {
                 let mut any = false;
                 for (a, gi) in e.x_index.iter().enumerate() {
-                    fl[a] = self.f[(*gi, k)];
+                    fl[a] = self.first.f[(*gi, k)];
                     any |= fl[a] != 0.0;
                 }
                 if !any {
