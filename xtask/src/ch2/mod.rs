@@ -11,6 +11,7 @@ pub mod chain;
 pub mod curves;
 pub mod report;
 pub mod segments;
+pub mod shaft;
 pub mod spin_up;
 pub mod universal_joint;
 
