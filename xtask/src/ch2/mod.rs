@@ -12,6 +12,8 @@ pub mod curves;
 pub mod report;
 pub mod segments;
 pub mod shaft;
+pub mod shaft_report;
+pub mod shaft_study;
 pub mod spin_up;
 pub mod universal_joint;
 

@@ -101,8 +101,12 @@ pub fn build_halves(dir: &Path, joined: Joined, mesh: ShaftMesh) -> Result<Built
 /// What drives the shaft in a scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Drive {
-    /// The spin-up (2.41) on the fixed end's x hinge.
-    SpinUp,
+    /// The spin-up (2.41) to `omega` (rad/s) over [`T_SPIN`] on the fixed
+    /// end's x hinge.
+    SpinUp {
+        /// Final angular velocity (rad/s); the thesis's is [`OMEGA`].
+        omega: f64,
+    },
     /// The x hinge held at zero and a unit force along y at M (the static
     /// reference (2.43), scaled by the load scale).
     StaticForce,
@@ -156,12 +160,16 @@ pub fn scene(t: VelocityTransform, joined: Joined, drive: Drive) -> String {
             rigid.push(format!(r#"Def("{j}", "{d}")"#));
         }
     }
-    for d in [("se1", "elongation"), ("se2", "elongation"), ("se2", "torsion")] {
+    for d in [
+        ("se1", "elongation"),
+        ("se2", "elongation"),
+        ("se2", "torsion"),
+    ] {
         rigid.push(format!(r#"Def("{}", "{}")"#, d.0, d.1));
     }
     let (drive_fn, loads, what) = match drive {
-        Drive::SpinUp => (
-            format!("SpinUp(omega: {OMEGA:?}, duration: {T_SPIN:?})"),
+        Drive::SpinUp { omega } => (
+            format!("SpinUp(omega: {omega:?}, duration: {T_SPIN:?})"),
             String::new(),
             "spin-up (2.41)",
         ),
@@ -302,11 +310,7 @@ pub fn run(
     for k in 1..n {
         work[k] = work[k - 1] + 0.5 * (power[k] + power[k - 1]) * (tr.t[k] - tr.t[k - 1]);
     }
-    let dr = tr
-        .x
-        .iter()
-        .map(|x| x[m[1]].hypot(x[m[2]]))
-        .collect();
+    let dr = tr.x.iter().map(|x| x[m[1]].hypot(x[m[2]])).collect();
     Ok(ShaftResponse {
         t: tr.t.clone(),
         dr,
@@ -321,9 +325,15 @@ pub fn run(
 }
 
 /// The static reference (2.43): the y deflection of M under
-/// F_c = m_u Ω² (r + Δr) along y, iterated from Δr = 0 until it changes by
-/// less than 1e-12 m; returns Δr and the iterations.
-pub fn static_reference(scene: &str, dir: &Path, m_u: f64) -> Result<(f64, usize), String> {
+/// F_c = m_u Ω² (r + Δr) along y (`scene` with [`Drive::StaticForce`]),
+/// iterated from Δr = 0 until it changes by less than 1e-12 m; returns Δr
+/// and the iterations.
+pub fn static_reference(
+    scene: &str,
+    dir: &Path,
+    m_u: f64,
+    omega: f64,
+) -> Result<(f64, usize), String> {
     let mech = mechanism(scene, dir)?;
     let m = mech
         .node("M")
@@ -335,7 +345,7 @@ pub fn static_reference(scene: &str, dir: &Path, m_u: f64) -> Result<(f64, usize
     let opts = StaticOptions::default();
     let mut dr = 0.0;
     for it in 1..=50 {
-        dy.set_load_scale(m_u * OMEGA * OMEGA * (R + dr));
+        dy.set_load_scale(m_u * omega * omega * (R + dr));
         let s = dy
             .static_equilibrium(0.0, &q0, &opts)
             .map_err(|e| format!("static reference: {e}"))?;
@@ -352,7 +362,7 @@ pub fn static_reference(scene: &str, dir: &Path, m_u: f64) -> Result<(f64, usize
 
 /// The Euler–Bernoulli estimate of (2.43): two rods of length l, pinned at
 /// the supports and guided at the rigid cylinder, k = 2 · 3EI/l³ with
-/// I = π d1⁴/64, and Δr = m_u Ω² r / (k − m_u Ω²).
+/// I = π d1⁴/64, and Δr = m_u Ω² r / (k − m_u Ω²) at Ω = [`OMEGA`].
 pub fn euler_bernoulli(m_u: f64) -> f64 {
     let e = segments::steel().e;
     let i = std::f64::consts::PI * D1.powi(4) / 64.0;
