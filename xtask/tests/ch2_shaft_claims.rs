@@ -69,9 +69,9 @@ fn steady(t: VelocityTransform, j: Joined) -> f64 {
 /// * m_u = ρπd2²/4·l = 0.41351 kg, the 0.4135 kg of (2.43);
 /// * Euler–Bernoulli's pinned–guided rods give Δr = 1.36e-3 m;
 /// * a half's M̄ has the mass of a rod and half the cylinder within 0.1 %
-///   (measured −0.014 %: the mapped discs' area);
-/// * our FE static Δr is within 3 % of Euler–Bernoulli's (measured −2.2 %,
-///   1.3316e-3 m; the thesis's 1.44e-3 m is 7.5 % above ours, see the
+///   (measured −0.002 %: the mapped discs' area);
+/// * our FE static Δr is within 1 % of Euler–Bernoulli's (measured −0.14 %,
+///   1.3601e-3 m; the thesis's 1.44e-3 m is 5.9 % above ours, see the
 ///   report) and the same whichever way the halves are joined (1e-9).
 #[test]
 fn table_2_2_mass_check_and_the_static_reference() {
@@ -108,8 +108,9 @@ fn table_2_2_mass_check_and_the_static_reference() {
 }
 
 /// Fig. 2.15, joined at q: only B3 converges to the static reference (within
-/// 1 %, measured +0.04 %); B1 and B2 have large steady-state errors (more
-/// than 10 %, measured −42 % and −22 %), B1's the largest.
+/// 1 %, measured +0.055 %);
+/// B1 and B2 have large steady-state errors (more than 10 %, measured
+/// −41.7 % and −22.0 %), B1's the largest.
 #[test]
 fn joined_at_q_only_b3_is_right_and_b1_errs_most() {
     let dr = reference();
@@ -130,10 +131,10 @@ fn joined_at_q_only_b3_is_right_and_b1_errs_most() {
     );
 }
 
-/// Fig. 2.16, joined at p: B1 becomes right (within 1 %, measured −0.01 %);
+/// Fig. 2.16, joined at p: B1 becomes right (within 1 %, measured +0.042 %);
 /// "exchanging the p- and q-nodes has no effect" on B2 and B3: their steady
 /// states equal those joined at q to 1e-5 (the integration tolerance is
-/// 1e-6; measured 2e-9 and 1e-8), so B2 stays wrong and B3 right.
+/// 1e-6; measured 1e-10 and 3e-14), so B2 stays wrong and B3 right.
 #[test]
 fn joined_at_p_b1_becomes_right_and_b2_and_b3_do_not_change() {
     let dr = reference();
@@ -156,7 +157,7 @@ fn joined_at_p_b1_becomes_right_and_b2_and_b3_do_not_change() {
 /// "The energy balance ... remains zero within the simulation error
 /// tolerances for all three cases": |T + V − W| over the run, W the drive
 /// moment's work, below 1e-5 of the largest T + V in all six runs (rtol
-/// 1e-6; measured at most 6e-7); and it is no identity: the drive does
+/// 1e-6; measured at most 2.9e-7); and it is no identity: the drive does
 /// work (T + V reaches 0.03 J).
 #[test]
 fn the_energy_balance_holds_for_every_transformation() {

@@ -18,14 +18,9 @@ pub fn aluminium() -> Material {
     }
 }
 
-/// The steel of Table 2.2: E = 2.1e11 Pa, G = 8.0e10 Pa, ρ = 7800 kg/m³.
-pub fn steel() -> Material {
-    Material {
-        e: 2.1e11,
-        g: 8.0e10,
-        rho: 7800.0,
-    }
-}
+/// The steel of Table 2.2 (E = 2.1e11 Pa, G = 8.0e10 Pa, ρ = 7800 kg/m³),
+/// the same as chapters 3 and 4 use.
+pub use crate::ch4::parts::steel;
 
 /// How half of the unbalanced shaft is meshed
 /// ([`parts::unbalanced_shaft_half`]): `section` × `section` elements
