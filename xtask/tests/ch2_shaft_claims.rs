@@ -219,3 +219,80 @@ fn a_missing_superelement_file_is_named() {
     assert!(e.contains("shaft_half1_p.ron"), "{e}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The report's section from the six runs: the thesis's numbers beside
+/// ours, each run's row, and Figs 2.15a/2.16a as CSV, SVG and PNG whose
+/// data are the runs' Δr.
+#[test]
+fn the_report_section_puts_the_thesis_beside_the_runs() {
+    let out = temp_dir("report");
+    let r = study::ShaftResults {
+        statics: vec![study::StaticRow {
+            mesh: shaft::MESH,
+            description: "default".into(),
+            half_mass: study::half_mass_analytic(),
+            dr: reference(),
+            iterations: 1,
+        }],
+        runs: runs().to_vec(),
+    };
+    let mut md = String::new();
+    let mut figs = xtask::report::Figures::default();
+    xtask::ch2::shaft_report::section(&out, &r, &mut md, &mut figs).unwrap();
+    assert!(md.contains("## Unbalanced shaft (Table 2.2)"));
+    assert!(md.contains("1.440e-3"), "the thesis's static Δr");
+    assert!(
+        md.contains(&format!("{:.4e}", reference())),
+        "our static Δr"
+    );
+    for run in runs() {
+        assert!(
+            md.contains(&format!("{:.4e}", run.steady())),
+            "{:?} at {}: no row",
+            run.transform,
+            run.joined.label()
+        );
+    }
+    for stem in ["fig2_15a_shaft_joined_q", "fig2_16a_shaft_joined_p"] {
+        for ext in ["svg", "png"] {
+            let f = out.join(format!("{stem}.{ext}"));
+            assert!(
+                std::fs::metadata(&f)
+                    .map(|m| m.len() > 1000)
+                    .unwrap_or(false),
+                "{}",
+                f.display()
+            );
+        }
+        let csv = std::fs::read_to_string(out.join(format!("{stem}.csv"))).unwrap();
+        let header = csv.lines().find(|l| !l.starts_with('#')).unwrap();
+        assert!(
+            header.contains("B1") && header.contains("B3") && header.contains("static"),
+            "{header}"
+        );
+        // the last row's B1 column is that run's last Δr
+        let joined = if stem.ends_with('q') {
+            Joined::AtQ
+        } else {
+            Joined::AtP
+        };
+        let b1 = runs()
+            .iter()
+            .find(|x| x.transform == B1 && x.joined == joined)
+            .unwrap();
+        let last: Vec<f64> = csv
+            .lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect();
+        let want = *b1.response.dr.last().unwrap();
+        assert!(
+            (last[1] - want).abs() <= 1e-9 * want,
+            "{} against {want}",
+            last[1]
+        );
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
