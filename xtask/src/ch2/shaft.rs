@@ -115,7 +115,7 @@ pub enum Drive {
     StaticForce,
 }
 
-/// The shaft scene: superelement files [`file`] in the run's directory.
+/// The shaft scene: superelement files named by [`file()`] in the run's directory.
 pub fn scene(t: VelocityTransform, joined: Joined, drive: Drive) -> String {
     let (x0, xm, x1) = (-L, 0.5 * L, 2.0 * L);
     let at = |x: f64| format!("[{x:.15}, 0.0, 0.0]");
