@@ -11,6 +11,14 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use xtask::ch2::shaft::{self, Drive, Joined};
 use xtask::ch2::shaft_study::{self as study, SpinRun};
+use xtask::ch2::spin_up::Integration;
+
+/// Generalized-α at rtol 1e-6, atol 1e-9, as the report's runs.
+const GA: Integration = Integration {
+    integrator: Integrator::GeneralizedAlpha,
+    rtol: 1e-6,
+    atol: 1e-9,
+};
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("flexmb-shaft-{name}-{}", std::process::id()));
@@ -187,16 +195,7 @@ fn b3_follows_the_static_reference_at_a_higher_speed() {
     let s = shaft::scene(B3, Joined::AtQ, Drive::StaticForce);
     let (dr, _) = shaft::static_reference(&s, halves(), shaft::M_U_THESIS, omega).unwrap();
     let spin = shaft::scene(B3, Joined::AtQ, Drive::SpinUp { omega });
-    let r = shaft::run(
-        &spin,
-        halves(),
-        Integrator::GeneralizedAlpha,
-        1e-6,
-        1e-9,
-        20.0,
-        2001,
-    )
-    .unwrap();
+    let r = shaft::run(&spin, halves(), GA, 20.0, 2001).unwrap();
     let steady = r.mean_after(study::STEADY_FROM);
     eprintln!("Ω = 40 rad/s: static {dr:e}, B3 {steady:e}");
     assert!(dr > 2.0 * reference(), "static {dr:e}");
@@ -215,7 +214,7 @@ fn a_missing_superelement_file_is_named() {
     let e = shaft::static_reference(&s, &d, shaft::M_U_THESIS, shaft::OMEGA).unwrap_err();
     assert!(e.contains("shaft_half1_q.ron"), "{e}");
     let s = shaft::scene(B1, Joined::AtP, Drive::SpinUp { omega: 25.0 });
-    let e = shaft::run(&s, &d, Integrator::GeneralizedAlpha, 1e-6, 1e-9, 1.0, 11).unwrap_err();
+    let e = shaft::run(&s, &d, GA, 1.0, 11).unwrap_err();
     assert!(e.contains("shaft_half1_p.ron"), "{e}");
     let _ = std::fs::remove_dir_all(&d);
 }

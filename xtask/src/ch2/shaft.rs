@@ -25,7 +25,8 @@
 
 use super::chain;
 use super::segments::{self, Built, ShaftMesh};
-use flexmb_dynamics::{Dynamics, Integrator, StaticOptions};
+use super::spin_up::Integration;
+use flexmb_dynamics::{Dynamics, StaticOptions};
 use flexmb_element::VelocityTransform;
 use flexmb_model::{Mechanism, Scene};
 use flexmb_superelement::parts::ShaftHalf;
@@ -269,13 +270,19 @@ impl ShaftResponse {
 pub fn run(
     scene: &str,
     dir: &Path,
-    integrator: Integrator,
-    rtol: f64,
-    atol: f64,
+    how: Integration,
     t_end: f64,
     outputs: usize,
 ) -> Result<ShaftResponse, String> {
-    let r = chain::run_from_rest(scene, dir, integrator, rtol, atol, t_end, outputs)?;
+    let r = chain::run_from_rest(
+        scene,
+        dir,
+        how.integrator,
+        how.rtol,
+        how.atol,
+        t_end,
+        outputs,
+    )?;
     let mech = r.mech.clone();
     let m = r.position_of("M")?;
     let g = mech

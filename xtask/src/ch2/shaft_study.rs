@@ -5,7 +5,7 @@
 
 use super::segments::ShaftMesh;
 use super::shaft::{self, Drive, Joined, ShaftResponse};
-use super::spin_up::integrator_name;
+use super::spin_up::{integrator_name, Integration};
 use flexmb_dynamics::Integrator;
 use flexmb_element::VelocityTransform::{self, B1, B2, B3};
 use flexmb_superelement::RigidBodyProperties;
@@ -156,12 +156,15 @@ pub fn spin(
     rtol: f64,
 ) -> Result<SpinRun, String> {
     let scene = shaft::scene(t, joined, SPIN_UP);
+    let how = Integration {
+        integrator,
+        rtol,
+        atol: 1e-3 * rtol,
+    };
     let response = shaft::run(
         &scene,
         dir,
-        integrator,
-        rtol,
-        1e-3 * rtol,
+        how,
         T_END,
         (T_END * OUTPUTS_PER_SECOND) as usize + 1,
     )?;
