@@ -310,7 +310,7 @@ pub fn compute(dir: &Path, o: &Ch2Options, pg: &Progress) -> Result<Results, Str
         }
     }
     let curves = super::curves::compute(dir)?;
-    let bar = pg.bar("unbalanced shaft", 12);
+    let bar = pg.bar("unbalanced shaft", super::shaft_study::job_count() as u64);
     let shaft = super::shaft_study::compute(dir, &|line| bar.item_done(&line))?;
     bar.finish();
     Ok(Results {

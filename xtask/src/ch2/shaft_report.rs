@@ -109,7 +109,7 @@ pub fn section(
         "steady Δr (m)",
         "against the static reference",
         "oscillation after T (± m)",
-        "max |T + V − W| / max(T + V)",
+        "max \\|T + V − W\\| / max(T + V)",
         "steps",
         "evaluations",
         "wall time (s)",
@@ -183,7 +183,7 @@ pub fn section(
         "run",
         "steady Δr (m)",
         "against generalized-α at rtol",
-        "max |T + V − W| / max(T + V)",
+        "max \\|T + V − W\\| / max(T + V)",
         "steps",
         "wall time (s)",
     ]);

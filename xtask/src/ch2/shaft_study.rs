@@ -177,6 +177,28 @@ pub fn spin(
     })
 }
 
+/// The spin-ups of [`compute`], longest first: the Adams check, B3 at
+/// RTOL/10, then the six runs with generalized-α at [`RTOL`].
+fn spin_jobs() -> Vec<(VelocityTransform, Joined, Integrator, f64)> {
+    let ga = Integrator::GeneralizedAlpha;
+    let mut jobs = vec![
+        (B1, Joined::AtQ, Integrator::Adams, RTOL),
+        (B3, Joined::AtQ, ga, 0.1 * RTOL),
+    ];
+    for joined in [Joined::AtQ, Joined::AtP] {
+        for t in [B1, B2, B3] {
+            jobs.push((t, joined, ga, RTOL));
+        }
+    }
+    jobs
+}
+
+/// The number of items [`compute`] reports as done: the static references
+/// and the spin-ups.
+pub fn job_count() -> usize {
+    MESHES.len() + spin_jobs().len()
+}
+
 /// Builds the halves into `dir`, writes every scene there (so that
 /// `flexmb simulate --integrator genalpha` repeats each run), and runs the
 /// static references and the spin-ups in parallel; `done` is called with a
@@ -209,17 +231,7 @@ pub fn compute(dir: &Path, done: &(dyn Fn(String) + Sync)) -> Result<ShaftResult
             r
         })
         .collect();
-    let ga = Integrator::GeneralizedAlpha;
-    let mut jobs = vec![
-        (B1, Joined::AtQ, Integrator::Adams, RTOL),
-        (B3, Joined::AtQ, ga, 0.1 * RTOL),
-    ];
-    for joined in [Joined::AtQ, Joined::AtP] {
-        for t in [B1, B2, B3] {
-            jobs.push((t, joined, ga, RTOL));
-        }
-    }
-    let runs: Vec<Result<SpinRun, String>> = jobs
+    let runs: Vec<Result<SpinRun, String>> = spin_jobs()
         .par_iter()
         .map(|&(t, joined, integrator, rtol)| {
             let r = spin(dir, t, joined, integrator, rtol);
