@@ -4,7 +4,7 @@
 //! interfaces, §2.2), thesis (2.17).
 
 use flexmb_element::{LinearSuperelement, Material};
-use flexmb_superelement::parts::{self, Part};
+use flexmb_superelement::parts::{self, Part, ShaftHalf};
 use flexmb_superelement::{build, spec, BuildResult};
 use std::path::Path;
 
@@ -16,6 +16,24 @@ pub fn aluminium() -> Material {
         g: 6.895e10 / 2.6,
         rho: 2766.67,
     }
+}
+
+/// The steel of Table 2.2 (E = 2.1e11 Pa, G = 8.0e10 Pa, ρ = 7800 kg/m³),
+/// the same as chapters 3 and 4 use.
+pub use crate::ch4::parts::steel;
+
+/// How half of the unbalanced shaft is meshed
+/// ([`parts::unbalanced_shaft_half`]): `section` × `section` elements
+/// across the cylinder, `rod` along the rod (2 × 2 across it), `cylinder`
+/// along the half cylinder.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShaftMesh {
+    /// Elements across the cylinder's section (each way).
+    pub section: usize,
+    /// Elements along the rod.
+    pub rod: usize,
+    /// Elements along the half cylinder.
+    pub cylinder: usize,
 }
 
 /// How a prismatic segment is meshed: `per_metre` elements per metre along
@@ -90,6 +108,28 @@ pub fn beam_segment(
     let part = parts::prismatic_bar(l, by, bz, n, aluminium()).map_err(|e| e.to_string())?;
     let part = if reversed { part.reversed() } else { part };
     finish(&part, "segment", fe_modes)
+}
+
+/// Half of the unbalanced shaft of Table 2.2 with a rod of length
+/// `rod_len`, built with p at the rod's end and q at the middle or, when
+/// `joined_at_p`, the other way round (thesis Fig. 2.16).
+pub fn shaft_half(
+    half: ShaftHalf,
+    rod_len: f64,
+    mesh: ShaftMesh,
+    joined_at_p: bool,
+) -> Result<Built, String> {
+    let part = parts::unbalanced_shaft_half(
+        half,
+        rod_len,
+        mesh.section,
+        mesh.rod,
+        mesh.cylinder,
+        steel(),
+    )
+    .map_err(|e| e.to_string())?;
+    let part = if joined_at_p { part.reversed() } else { part };
+    finish(&part, "shaft half", 0)
 }
 
 /// Writes a superelement file.

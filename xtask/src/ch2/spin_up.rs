@@ -183,12 +183,21 @@ impl Integration {
     }
     /// For tables.
     pub fn label(&self) -> String {
-        let name = match self.integrator {
-            Integrator::Dopri5 => "DOPRI5",
-            Integrator::Adams => "Adams",
-            Integrator::GeneralizedAlpha => "generalized-α",
-        };
-        format!("{name} rtol {:.0e} atol {:.0e}", self.rtol, self.atol)
+        format!(
+            "{} rtol {:.0e} atol {:.0e}",
+            integrator_name(self.integrator),
+            self.rtol,
+            self.atol
+        )
+    }
+}
+
+/// An integrator's name for reports.
+pub fn integrator_name(i: Integrator) -> &'static str {
+    match i {
+        Integrator::Dopri5 => "DOPRI5",
+        Integrator::Adams => "Adams",
+        Integrator::GeneralizedAlpha => "generalized-α",
     }
 }
 
