@@ -184,13 +184,21 @@ pub fn bending_content(p: &ModalPoint, sym: &ModalPoint, crossing: f64) -> f64 {
     )
 }
 
+/// Half the width (N m) of the zoom around the symmetric layout's crossing
+/// on which [`Variant::curve`] is sampled (about ±0.11°).
+pub const ZOOM: f64 = 0.001;
+
+/// Points of the zoom.
+pub const ZOOM_POINTS: usize = 81;
+
 /// What [`measure`] finds for one offset.
 pub struct Variant {
     /// The mass's offset e along the sheet's height (m).
     pub offset: f64,
-    /// The grid's points: ϕ (degrees), ω4, ω5 (Hz) and the bending content
-    /// of mode 4.
-    pub curve: Vec<[f64; 4]>,
+    /// The zoom around the symmetric layout's crossing (M within ±[`ZOOM`]
+    /// of it): M (N m), ϕ (degrees), ω4, ω5 (Hz) and the bending content of
+    /// mode 4 ([`bending_content`]) at each point.
+    pub curve: Vec<[f64; 5]>,
     /// The closest approach on each refinement level.
     pub levels: Vec<Closest>,
     /// The bending content of mode 4 at the finest level's closest point.
@@ -205,10 +213,11 @@ impl Variant {
 }
 
 /// Measures the meeting of modes 4 and 5 of `kind` (superelement file
-/// `file` in `dir`) for each of `offsets` along the grid `lambdas`
-/// (ascending, evenly spaced; [`refine`] with `levels` refinements), the
-/// offsets in parallel. The symmetric layout (offset 0) is always computed:
-/// its modes are the reference shapes of [`bending_content`].
+/// `file` in `dir`) for each of `offsets`: [`refine`] from the grid
+/// `lambdas` (ascending, evenly spaced) with `levels` refinements, and the
+/// [`ZOOM`] around the symmetric layout's crossing; the offsets in
+/// parallel. The symmetric layout (offset 0) is always computed: its modes
+/// are the reference shapes of [`bending_content`].
 pub fn measure(
     kind: Kind,
     dir: &Path,
@@ -218,20 +227,20 @@ pub fn measure(
     levels: usize,
 ) -> Result<Vec<Variant>, String> {
     let sym_mech = mechanism(kind, dir, file, 0.0)?;
-    let sym = modal_points(&sym_mech, lambdas)?;
     let sym_levels = refine(&sym_mech, lambdas, levels)?;
     let crossing = sym_levels.last().map_or(f64::NAN, |c| c.lambda);
+    let zoom: Vec<f64> = (0..ZOOM_POINTS)
+        .map(|k| crossing + (2.0 * k as f64 / (ZOOM_POINTS - 1) as f64 - 1.0) * ZOOM / M_MAX)
+        .collect();
+    let sym = modal_points(&sym_mech, &zoom)?;
     offsets
         .par_iter()
         .map(|e| {
+            let m = mechanism(kind, dir, file, *e)?;
             let (points, levels) = if *e == 0.0 {
                 (None, sym_levels.clone())
             } else {
-                let m = mechanism(kind, dir, file, *e)?;
-                (
-                    Some(modal_points(&m, lambdas)?),
-                    refine(&m, lambdas, levels)?,
-                )
+                (Some(modal_points(&m, &zoom)?), refine(&m, lambdas, levels)?)
             };
             let points = points.as_deref().unwrap_or(&sym);
             let curve = points
@@ -239,6 +248,7 @@ pub fn measure(
                 .zip(&sym)
                 .map(|(p, s)| {
                     [
+                        p.lambda * M_MAX,
                         p.phi,
                         p.freqs[3],
                         p.freqs[4],
@@ -248,7 +258,6 @@ pub fn measure(
                 .collect();
             // the shapes at the finest grid's closest point
             let c = levels.last().ok_or("no refinement level")?;
-            let m = mechanism(kind, dir, file, *e)?;
             let at = modal_points(&m, &[c.lambda])?;
             let s = modal_points(&sym_mech, &[c.lambda])?;
             Ok(Variant {
@@ -259,4 +268,22 @@ pub fn measure(
             })
         })
         .collect()
+}
+
+/// The CalculiX solid (8 × 8 × 1 C3D20R) of the symmetric layout, refined
+/// around its crossing (`research/ch3/flexure.py --refine 4`).
+pub const SOLID_SYMMETRIC: &str = "fixtures/curves/solid/flexure_ch3_veering_refined_8x8x1.csv";
+
+/// The same with the mass lifted by [`SOLID_OFFSET_E`] (`--offset 0.02`).
+pub const SOLID_OFFSET: &str = "fixtures/curves/solid/flexure_ch3_veering_offset20mm_8x8x1.csv";
+
+/// The mass's offset of [`SOLID_OFFSET`] (m): h/2.
+pub const SOLID_OFFSET_E: f64 = 0.02;
+
+/// The sample of a solid where ω5 − ω4 is smallest.
+pub fn solid_closest(points: &[super::SolidPoint]) -> Option<&super::SolidPoint> {
+    points
+        .iter()
+        .filter(|p| p.freqs.len() >= 5)
+        .min_by(|a, b| (a.freqs[4] - a.freqs[3]).total_cmp(&(b.freqs[4] - b.freqs[3])))
 }
