@@ -29,7 +29,7 @@ use std::sync::Arc;
 pub const OFFSETS: [f64; 5] = [0.0, 0.0025, 0.005, 0.01, 0.02];
 
 /// Modes kept per point (ω4 and ω5 and one above).
-const COUNT: usize = 6;
+pub const COUNT: usize = 6;
 
 /// Points per refinement level (over the two grid intervals around the
 /// previous level's closest point: the step shrinks tenfold).
