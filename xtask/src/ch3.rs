@@ -246,7 +246,7 @@ pub fn curve(
 
 /// The mechanism of one model with the mass's `offset`
 /// ([`scene_with_offset`]), its superelement files read from `dir`.
-pub fn mechanism(
+pub fn flexure_mechanism(
     kind: Kind,
     dir: &Path,
     file: &str,
@@ -269,7 +269,7 @@ pub fn curve_at(
     lambdas: &[f64],
     count: usize,
 ) -> Result<Vec<CurvePoint>, String> {
-    let mech = mechanism(kind, dir, file, 0.0)?;
+    let mech = flexure_mechanism(kind, dir, file, 0.0)?;
     let phi = rotation_about(&mech, &format!("N{SEGMENTS}"), 1)?;
     let model = Model::new(kind.label(), &mech, ModelKind::Unreduced);
     quasi_static_curve_of(&model, 0.0, lambdas, count, &|x| vec![phi(x)])

@@ -13,7 +13,7 @@
 //! modes' character across it ([`bending_content`]: the mass-weighted MAC of
 //! mode 4 with the symmetric layout's bending mode at the same moment).
 
-use super::{mechanism, rotation_about, Kind, M_MAX, SEGMENTS};
+use super::{flexure_mechanism, rotation_about, Kind, M_MAX, SEGMENTS};
 use faer::Mat;
 use flexmb_dynamics::Dynamics;
 use flexmb_linearize::mac;
@@ -226,7 +226,7 @@ pub fn measure(
     lambdas: &[f64],
     levels: usize,
 ) -> Result<Vec<Variant>, String> {
-    let sym_mech = mechanism(kind, dir, file, 0.0)?;
+    let sym_mech = flexure_mechanism(kind, dir, file, 0.0)?;
     let sym_levels = refine(&sym_mech, lambdas, levels)?;
     let crossing = sym_levels.last().map_or(f64::NAN, |c| c.lambda);
     let zoom: Vec<f64> = (0..ZOOM_POINTS)
@@ -236,7 +236,7 @@ pub fn measure(
     offsets
         .par_iter()
         .map(|e| {
-            let m = mechanism(kind, dir, file, *e)?;
+            let m = flexure_mechanism(kind, dir, file, *e)?;
             let (points, levels) = if *e == 0.0 {
                 (None, sym_levels.clone())
             } else {
