@@ -111,19 +111,24 @@ def main():
                     help="the moments' signs to run (pos and neg both include M = 0)")
     ap.add_argument("--reuse", action="store_true", help="parse existing .dat files in --out, do not run ccx")
     ap.add_argument("--refine", type=int, default=0, metavar="LEVELS",
-                    help="then LEVELS times: 9 moments over the two intervals around the one "
-                         "where f5 - f4 is smallest so far (the step shrinks by 4 per level)")
+                    help="then LEVELS times: --per-level moments over the two intervals around "
+                         "the one where f5 - f4 is smallest so far")
+    ap.add_argument("--per-level", type=int, default=9,
+                    help="moments per refinement level (odd; 9: the step shrinks by 4, 5: by 2)")
+    ap.add_argument("--resume", action="store_true",
+                    help="run ccx only for decks in --out without a finished log")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     print("case,M,phi_deg,mode,f_Hz")
     moments = sorted(([-m for m in a.ms] if a.sides != "pos" else []) + [0.0] + (a.ms if a.sides != "neg" else []))
     done = {m: run(a, m) for m in moments}
     for _ in range(a.refine):
-        grid = sorted(done)
+        grid = sorted(m for m in done if m != 0.0)  # the search leaves out the deck at rest
         i = min(range(len(grid)), key=lambda k: gap(done[grid[k]]))
         lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-        for k in range(9):
-            m = round(lo + (hi - lo) * k / 8, 10)
+        n = a.per_level - 1
+        for k in range(n + 1):
+            m = round(lo + (hi - lo) * k / n, 10)
             if m not in done:
                 done[m] = run(a, m)
     best = min(done, key=lambda m: gap(done[m]))
@@ -142,7 +147,9 @@ def run(a, m):
     job = f"m{m:+.{digits}f}".replace("+", "p").replace("-", "n").replace(".", "_")
     nn, ne = write(os.path.join(a.out, job + ".inp"), a, m if m != 0.0 else 1e-12)
     print(f"# {job}: {nn} nodes, {ne} elements", file=sys.stderr)
-    if not a.reuse:
+    log = os.path.join(a.out, job + ".log")
+    finished = os.path.exists(log) and "Job finished" in open(log).read()
+    if not (a.reuse or (a.resume and finished)):
         deck.run_ccx(job, a.out)
     rots, freqs = parse(os.path.join(a.out, job + ".dat"))
     if len(rots) != 1:

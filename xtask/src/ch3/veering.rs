@@ -270,14 +270,33 @@ pub fn measure(
         .collect()
 }
 
-/// The CalculiX solid (8 × 8 × 1 C3D20R) of the symmetric layout, refined
-/// around its crossing (`research/ch3/flexure.py --refine 4`).
-pub const SOLID_SYMMETRIC: &str = "fixtures/curves/solid/flexure_ch3_veering_refined_8x8x1.csv";
+/// A stored pair of CalculiX solids of the flexure (C3D20R), each refined
+/// around where its modes 4 and 5 meet (`research/ch3/flexure.py --refine`):
+/// the symmetric layout and the mass lifted by [`SOLID_OFFSET_E`].
+pub struct SolidPair {
+    /// The mesh (length × height × thickness).
+    pub mesh: &'static str,
+    /// The symmetric layout's file.
+    pub symmetric: &'static str,
+    /// The asymmetric layout's file (`--offset 0.02`).
+    pub offset: &'static str,
+}
 
-/// The same with the mass lifted by [`SOLID_OFFSET_E`] (`--offset 0.02`).
-pub const SOLID_OFFSET: &str = "fixtures/curves/solid/flexure_ch3_veering_offset20mm_8x8x1.csv";
+/// The stored solids, coarse to fine.
+pub const SOLIDS: [SolidPair; 2] = [
+    SolidPair {
+        mesh: "8 × 8 × 1",
+        symmetric: "fixtures/curves/solid/flexure_ch3_veering_refined_8x8x1.csv",
+        offset: "fixtures/curves/solid/flexure_ch3_veering_offset20mm_8x8x1.csv",
+    },
+    SolidPair {
+        mesh: "16 × 16 × 1",
+        symmetric: "fixtures/curves/solid/flexure_ch3_veering_refined_16x16x1.csv",
+        offset: "fixtures/curves/solid/flexure_ch3_veering_offset20mm_16x16x1.csv",
+    },
+];
 
-/// The mass's offset of [`SOLID_OFFSET`] (m): h/2.
+/// The mass's offset of [`SolidPair::offset`] (m): h/2.
 pub const SOLID_OFFSET_E: f64 = 0.02;
 
 /// The sample of a solid where ω5 − ω4 is smallest.
