@@ -188,8 +188,10 @@ pub fn bending_content(p: &ModalPoint, sym: &ModalPoint, crossing: f64) -> f64 {
 /// on which [`Variant::curve`] is sampled (about ±0.11°).
 pub const ZOOM: f64 = 0.001;
 
-/// Points of the zoom.
-pub const ZOOM_POINTS: usize = 81;
+/// Points of the zoom: an even number, so that none lies on the crossing
+/// itself, where the symmetric layout's two modes are degenerate and its
+/// bending mode is not defined.
+pub const ZOOM_POINTS: usize = 80;
 
 /// What [`measure`] finds for one offset.
 pub struct Variant {
