@@ -15,7 +15,14 @@ a moment on the rotation node that follows a perturbation step diverges, also
 without the mass node; the same static steps without the perturbation steps
 between them converge.)
 
+`--offset E` moves the mass node to (0.29, E, -0.1): the link's tip lifted by
+E along the sheet's height, out of the mirror plane y = 0 of the flexure (the
+asymmetric variant of docs/reproduce.md, "Where modes 4 and 5 meet"; E = 0.02
+is the link attached at the sheet's top edge). With no gravity and a massless
+link the static states are those of E = 0; only the inertia moves.
+
 Usage: python3 flexure.py --ms 0.1,0.2,0.3,0.4 --nl 20 --nh 20 --nt 2 --out DIR
+       [--offset E] [--sides neg --refine LEVELS]
 (the moments listed and their negatives, and M = 0)
 Prints CSV: case,M,phi_deg,mode,f_Hz (phi: the rotation node's U2, in degrees)
 """
@@ -30,16 +37,21 @@ E, NU, RHO = 2.1e11, 0.3125, 7800.0
 MASS_AT = (0.29, 0.0, -0.1)
 
 
+def mass_at(a):
+    return (MASS_AT[0], MASS_AT[1] + a.offset, MASS_AT[2])
+
+
 def write(path, a, m):
     # sheet.mesh: length along its y, height along z, thickness along x;
     # (x, y, z) -> (y, z, x) is a cyclic permutation (a proper rotation)
     nodes, elems, nid, (NI, NJ, NK) = mesh(L, H, T, a.nl, a.nh, a.nt)
-    out = ["*HEADING", f"short sheet flexure C3D20R {a.nl}x{a.nh}x{a.nt}", "*NODE"]
+    out = ["*HEADING", f"short sheet flexure C3D20R {a.nl}x{a.nh}x{a.nt} mass offset {a.offset}", "*NODE"]
     for n, (x, y, z) in nodes.items():
         out.append(f"{n},{y:.9e},{z:.9e},{x:.9e}")
     top = max(nodes)
     e_node, ref, rot = top + 1, top + 2, top + 3
-    out.append(f"{e_node},{MASS_AT[0]:.9e},{MASS_AT[1]:.9e},{MASS_AT[2]:.9e}")
+    at = mass_at(a)
+    out.append(f"{e_node},{at[0]:.9e},{at[1]:.9e},{at[2]:.9e}")
     out.append(f"{ref},{L:.9e},0.0,0.0\n{rot},{L:.9e},0.0,0.0")
     out.append("*ELEMENT,TYPE=C3D20R,ELSET=FLEX")
     for e, ns in elems:
@@ -92,25 +104,61 @@ def main():
     ap.add_argument("--nt", type=int, default=2)
     ap.add_argument("--modes", type=int, default=6)
     ap.add_argument("--incs", type=int, default=4)
+    ap.add_argument("--offset", type=float, default=0.0,
+                    help="the mass node's y (m): 0 is the mirror-symmetric layout")
     ap.add_argument("--out", default="/tmp/ch3/flexure")
     ap.add_argument("--sides", choices=["both", "pos", "neg"], default="both",
                     help="the moments' signs to run (pos and neg both include M = 0)")
     ap.add_argument("--reuse", action="store_true", help="parse existing .dat files in --out, do not run ccx")
+    ap.add_argument("--refine", type=int, default=0, metavar="LEVELS",
+                    help="then LEVELS times: --per-level moments over the two intervals around "
+                         "the one where f5 - f4 is smallest so far")
+    ap.add_argument("--per-level", type=int, default=9,
+                    help="moments per refinement level (odd; 9: the step shrinks by 4, 5: by 2)")
+    ap.add_argument("--resume", action="store_true",
+                    help="run ccx only for decks in --out without a finished log")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     print("case,M,phi_deg,mode,f_Hz")
     moments = sorted(([-m for m in a.ms] if a.sides != "pos" else []) + [0.0] + (a.ms if a.sides != "neg" else []))
-    for m in moments:
-        job = f"m{m:+.3f}".replace("+", "p").replace("-", "n").replace(".", "_")
-        nn, ne = write(os.path.join(a.out, job + ".inp"), a, m if m != 0.0 else 1e-12)
-        print(f"# {job}: {nn} nodes, {ne} elements", file=sys.stderr)
-        if not a.reuse:
-            deck.run_ccx(job, a.out)
-        rots, freqs = parse(os.path.join(a.out, job + ".dat"))
-        if len(rots) != 1:
-            raise SystemExit(f"{job}: {len(rots)} perturbation steps parsed, 1 expected")
-        for k, f in enumerate(freqs[0], 1):
-            print(f"solid,mesh={a.nl}x{a.nh}x{a.nt},{m:g},{math.degrees(rots[0]):.6f},{k},{f:.6f}")
+    done = {m: run(a, m) for m in moments}
+    for _ in range(a.refine):
+        grid = sorted(m for m in done if m != 0.0)  # the search leaves out the deck at rest
+        i = min(range(len(grid)), key=lambda k: gap(done[grid[k]]))
+        lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+        n = a.per_level - 1
+        for k in range(n + 1):
+            m = round(lo + (hi - lo) * k / n, 10)
+            if m not in done:
+                done[m] = run(a, m)
+    best = min(done, key=lambda m: gap(done[m]))
+    print(f"# closest: M = {best:g}, f5 - f4 = {gap(done[best]):.6f} Hz", file=sys.stderr)
+
+
+def gap(point):
+    """f5 - f4 of a run's (phi, freqs)."""
+    return point[1][4] - point[1][3]
+
+
+def run(a, m):
+    """One deck at moment m: writes, runs (unless --reuse) and parses it,
+    prints its CSV rows and returns (phi in degrees, frequencies)."""
+    digits = 3 if round(m, 3) == m else 7
+    job = f"m{m:+.{digits}f}".replace("+", "p").replace("-", "n").replace(".", "_")
+    nn, ne = write(os.path.join(a.out, job + ".inp"), a, m if m != 0.0 else 1e-12)
+    print(f"# {job}: {nn} nodes, {ne} elements", file=sys.stderr)
+    log = os.path.join(a.out, job + ".log")
+    finished = os.path.exists(log) and "Job finished" in open(log).read()
+    if not (a.reuse or (a.resume and finished)):
+        deck.run_ccx(job, a.out)
+    rots, freqs = parse(os.path.join(a.out, job + ".dat"))
+    if len(rots) != 1:
+        raise SystemExit(f"{job}: {len(rots)} perturbation steps parsed, 1 expected")
+    phi = math.degrees(rots[0])
+    case = f"mesh={a.nl}x{a.nh}x{a.nt}" + (f" offset={a.offset:g}" if a.offset else "")
+    for k, f in enumerate(freqs[0], 1):
+        print(f"solid,{case},{m:g},{phi:.6f},{k},{f:.6f}", flush=True)
+    return phi, freqs[0]
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@
 pub mod component;
 pub mod mechanism;
 pub mod response;
+pub mod veering;
 
 use crate::curves::StoredCurve;
 use crate::models::{quasi_static_curve_of, CurvePoint, Model, ModelKind};
@@ -143,12 +144,28 @@ pub fn build_segment(dir: &Path, mesh: [usize; 3], warping: bool) -> Result<Segm
 /// The scene of one model; `file` is the superelement file for SE-C and
 /// SE-CW.
 pub fn scene(kind: Kind, file: &str) -> String {
+    scene_with_offset(kind, file, 0.0)
+}
+
+/// [`scene`] with the link's tip and its mass lifted by `offset` (m) along
+/// the sheet's height y, out of the flexure's mirror plane y = 0: the link's
+/// corner K at (0.29, offset, 0), the mass at (0.29, offset, −0.1). 0 is
+/// [`scene`]'s mirror-symmetric layout; the asymmetric variants are
+/// [`veering`]'s. The link is rigid and massless and there is no gravity, so
+/// the offset moves the inertia only, not the static states.
+pub fn scene_with_offset(kind: Kind, file: &str, offset: f64) -> String {
     let dx = L / SEGMENTS as f64;
     let mut nodes: Vec<String> = (0..=SEGMENTS)
         .map(|i| format!(r#"(id: "N{i}", at: [{:e}, 0.0, 0.0])"#, i as f64 * dx))
         .collect();
-    nodes.push(format!(r#"(id: "K", at: [{:e}, 0.0, 0.0])"#, L + 0.25));
-    nodes.push(format!(r#"(id: "E", at: [{:e}, 0.0, -0.1])"#, L + 0.25));
+    nodes.push(format!(
+        r#"(id: "K", at: [{:e}, {offset:e}, 0.0])"#,
+        L + 0.25
+    ));
+    nodes.push(format!(
+        r#"(id: "E", at: [{:e}, {offset:e}, -0.1])"#,
+        L + 0.25
+    ));
     let mut elements = vec![];
     let mut fixed = vec![r#"Node("N0")"#.to_string()];
     for i in 0..SEGMENTS {
@@ -227,6 +244,22 @@ pub fn curve(
     curve_at(kind, dir, file, &lambdas, N_FREQ)
 }
 
+/// The mechanism of one model with the mass's `offset`
+/// ([`scene_with_offset`]), its superelement files read from `dir`.
+pub fn flexure_mechanism(
+    kind: Kind,
+    dir: &Path,
+    file: &str,
+    offset: f64,
+) -> Result<Arc<flexmb_model::Mechanism>, String> {
+    let text = scene_with_offset(kind, file, offset);
+    let s = Scene::from_ron_str(&text).map_err(|e| format!("{}: {e}", kind.label()))?;
+    Ok(Arc::new(
+        s.build(Some(dir))
+            .map_err(|e| format!("{}: {e}", kind.label()))?,
+    ))
+}
+
 /// ϕ and the first `count` eigenfrequencies of one model at the moments
 /// `lambdas` × [`M_MAX`] (continuation from M = 0).
 pub fn curve_at(
@@ -236,12 +269,7 @@ pub fn curve_at(
     lambdas: &[f64],
     count: usize,
 ) -> Result<Vec<CurvePoint>, String> {
-    let text = scene(kind, file);
-    let s = Scene::from_ron_str(&text).map_err(|e| format!("{}: {e}", kind.label()))?;
-    let mech = Arc::new(
-        s.build(Some(dir))
-            .map_err(|e| format!("{}: {e}", kind.label()))?,
-    );
+    let mech = flexure_mechanism(kind, dir, file, 0.0)?;
     let phi = rotation_about(&mech, &format!("N{SEGMENTS}"), 1)?;
     let model = Model::new(kind.label(), &mech, ModelKind::Unreduced);
     quasi_static_curve_of(&model, 0.0, lambdas, count, &|x| vec![phi(x)])
