@@ -130,11 +130,18 @@ impl DeformationKernel<18, 12> for AnticlasticKernel {
         out[4] = d1 * r[0][0] + d2 * r[0][1];
         out[5] = d2 * r[1][1];
         let m = &self.membrane_r;
+        // the twist rate Θ/l0 (Θ = torsion/l0): its trapeze strain ½τ²(z² − b²/12)
+        // is (b²/4) τ² g₁
+        let l0 = self.beam.l0;
+        let tau2 = e[1] * e[1] * (1.0 / (l0 * l0 * l0 * l0));
         for (g, xi) in gauss3().0.into_iter().enumerate() {
             let k = self.curvature(eb, xi);
             let (a1, a2) = (lerp(a1p, a1q, xi), lerp(a2p, a2q, xi));
-            out[6 + 2 * g] = k * (a1 * m[0][0] + a2 * m[0][1]);
-            out[7 + 2 * g] = k * (a2 * m[1][1]);
+            // the fibre at normal offset w on the sheet of curvature κ:
+            // strain −κw (a₁ ≈ −νκ: tension at the edges)
+            let (v1, v2) = (tau2 - k * a1, -(k * a2));
+            out[6 + 2 * g] = v1 * m[0][0] + v2 * m[0][1];
+            out[7 + 2 * g] = v2 * m[1][1];
         }
         out
     }

@@ -196,6 +196,7 @@ impl Expander<'_> {
             inertia: b.mass,
             velocity_transform: b.transform,
             warping: b.warping.is_some(),
+            plate_warping: b.anticlastic.is_some(),
         };
         let warp_groups = match &b.warping {
             None => vec![],
