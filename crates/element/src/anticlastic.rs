@@ -12,7 +12,7 @@
 //! it shares the beam's nodes and adds the curl w(s, z) = (b²/4)(a₁ g₁(ζ) +
 //! a₂ g₂(ζ)), ζ = 2z/b, with g₁″ = 1 and g₂″ = P₂(ζ) (so w_zz = a₁ + a₂ P₂,
 //! the first two Legendre polynomials) and ∫g = 0. Its two amplitudes a₁, a₂
-//! (1/m) at each node (one two-mode slot per node, shared with the
+//! (1/m; as coordinates η = (b²/4) a) at each node (one two-mode slot per node, shared with the
 //! neighbouring element) are linear along the element. Its energy is the
 //! plate's bending energy beyond the beam's EI κ²/2, with the beam's
 //! curvature κ(s) of the Hermite bending (end rotations θ_p = −ε_bp/l0,
@@ -22,7 +22,17 @@
 //!   EI = D b (1 − ν²));
 //! * twist of the curl along the sheet: D(1 − ν) ∫ w_sz² dz =
 //!   D (1 − ν)(b³/8) a′ᵀ G′ a′;
-//! * membrane: (E t/2) ∫ (κ w)² dz = (E t b⁵/64) κ² aᵀ G a,
+//! * membrane: (E t/2) ∫ ε² dz with the strain of the fibre at height z,
+//!   ε = −κw + ½τ²(z² − b²/12): the curl on the curved sheet (a fibre moved
+//!   by w towards the centre of curvature shortens) and the trapeze term of
+//!   the twist rate τ = Θ/l0 (Θ the beam's torsion angle). The mean strain is
+//!   the beam's elongation, and z² − b²/12 = (b²/2) g₁, so ε = (b²/4)
+//!   ((τ² − κa₁) g₁ − κa₂ g₂) and the energy is (E t b⁵/64) vᵀ G v,
+//!   v = (τ² − κa₁, −κa₂). In a bent sheet whose curl is held back (β large)
+//!   ε is a self-equilibrated stress, tension at the edges, and its product
+//!   with the trapeze strain stiffens the twist (Wagner): the Poisson share
+//!   of the deflected sheet's torsion-coupled modes. With τ alone it is
+//!   Buckley's (E t b⁵/1440) τ⁴;
 //!
 //! with G, G′ the Gram matrices of g and g′ on ζ ∈ [−1, 1]. Integrated exactly
 //! (two and three Gauss points along the element), each term is ½ S ε² of a
@@ -32,8 +42,12 @@
 //! is within 0.1 % of the converged one for β ≤ 20). The kinetic energy of
 //! the curl, (ρ t/2) ∫ ẇ² dz, is a constant mass over the amplitudes.
 //!
-//! With ν = 0 the curl decouples (its minimum is a = 0) and the beam is the
-//! thesis's.
+//! With ν = 0 the curl decouples (its minimum is a = 0 in every untwisted
+//! state), and the linearization about such a state is the beam's.
+//!
+//! The coordinates are η = (b²/4) a (m): the curl's deflection amplitudes,
+//! w = η₁ g₁ + η₂ g₂ (scaled so that their stiffness is not 1e-15 of the
+//! beam's, which a pivot test would call singular).
 
 use crate::element::{frame_from_axis, Element, Slot};
 use crate::kernels::{DeformationKernel, TwoNodeSpatial};
@@ -149,8 +163,8 @@ impl DeformationKernel<18, 12> for AnticlasticKernel {
 
 /// The anticlastic overlay of the spatial beam from p to q with local y the
 /// part of `up` orthogonal to the axis (the beam's own frame; module docs).
-/// Slots (rp, λp, rq, λq, a_p, a_q), the a's two-mode slots (a₁, a₂) of
-/// the curl in 1/m. The section must be a `Rectangle`: its thinner side is
+/// Slots (rp, λp, rq, λq, η_p, η_q), the η's two-mode slots (η₁, η₂) of
+/// the curl in m (η = (b²/4) a). The section must be a `Rectangle`: its thinner side is
 /// the thickness t, the other the height b, and the weak plane is that of
 /// bending about the axis along b. `inertia` adds the curl's kinetic energy.
 pub fn anticlastic_overlay(
@@ -163,12 +177,9 @@ pub fn anticlastic_overlay(
 ) -> Result<Element, ElementError> {
     mat.validate()?;
     let SectionShape::Rectangle { by, bz } = *shape else {
-        return Err(ElementError::InvalidProperty {
-            what: "section of a beam with `anticlastic`".into(),
-            value: f64::NAN,
-            why: format!(
-                "the anticlastic curl is that of a sheet: give a Rectangle section, not {shape:?}"
-            ),
+        return Err(ElementError::MissingProperty {
+            what: "a Rectangle section for `anticlastic`".into(),
+            why: format!("the anticlastic curl is that of a sheet (height and thickness); {shape:?} is not one"),
         });
     };
     // bending about local y (iy = by bz³/12) is weak when bz is the thickness
