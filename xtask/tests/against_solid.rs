@@ -68,13 +68,11 @@ fn the_warping_guidance_holds_the_solid_curves_within_2_percent() {
 
 /// The Poisson share (ν = 0.3 solid): the warping beams with the sheets'
 /// anticlastic curl (fixtures/scenes/straight_guidance_spatial_anticlastic.ron)
-/// hold the physical solid's in-plane f1 and f4 within 1 % at every stored
-/// stroke, where the warping beams alone fall 3.9 % below f1 at 0.0834 m.
-/// The torsion-coupled f2 and f3 are not matched yet: they stay 4.0 % and
-/// 4.6 % below at 0.0834 m (measured; docs/validation.md), and the test holds
-/// them there, between −5 % and 0, so that a change of the model shows.
+/// hold the physical solid's f1–f4 within 2 % at every stored stroke (measured
+/// ≤ 1.51 %, f3 at 0.0834 m), where the warping beams alone fall 4.1 % below
+/// its f1 and 4.0 % below its f3.
 #[test]
-fn the_anticlastic_guidance_holds_the_physical_solid_in_the_plane() {
+fn the_anticlastic_guidance_holds_the_physical_solid_within_2_percent() {
     let root = xtask::workspace_root();
     let (_, physical) = stored_solids(&root).unwrap();
     let solid = physical.expect("fixtures/curves/solid/solid_guidance_nu03_50x8x2.csv");
@@ -105,35 +103,22 @@ fn the_anticlastic_guidance_holds_the_physical_solid_in_the_plane() {
     );
     let (warped, curled) = (warped.unwrap(), curled.unwrap());
     assert_eq!(curled.dofs, 308);
-    let mut worst_in = 0.0f64;
-    let mut worst_in_warped = 0.0f64;
+    let (mut worst, mut worst_warped) = (0.0f64, 0.0f64);
     for (i, (x, s)) in solid.points.iter().enumerate() {
         let gap = |f: &[f64], k: usize| f[k] / s[k] - 1.0;
-        let g: Vec<f64> = (0..4).map(|k| gap(&curled.freqs[i], k)).collect();
-        let w: Vec<f64> = (0..4).map(|k| gap(&warped.freqs[i], k)).collect();
+        let g: Vec<f64> = (0..4).map(|k| 100.0 * gap(&curled.freqs[i], k)).collect();
+        let w: Vec<f64> = (0..4).map(|k| 100.0 * gap(&warped.freqs[i], k)).collect();
         eprintln!(
             "x_S = {x}: model − ν = 0.3 solid, f1 … f4: warping {:+.2} {:+.2} {:+.2} {:+.2} %; anticlastic {:+.2} {:+.2} {:+.2} {:+.2} %",
-            100.0 * w[0], 100.0 * w[1], 100.0 * w[2], 100.0 * w[3],
-            100.0 * g[0], 100.0 * g[1], 100.0 * g[2], 100.0 * g[3],
+            w[0], w[1], w[2], w[3], g[0], g[1], g[2], g[3],
         );
-        for k in [0, 3] {
-            worst_in = worst_in.max(g[k].abs());
-            worst_in_warped = worst_in_warped.max(w[k].abs());
-        }
-        for k in [1, 2] {
-            assert!(
-                g[k] > -0.05 && g[k] < 0.0,
-                "x_S = {x}: f{} {:+.4}",
-                k + 1,
-                g[k]
-            );
+        for k in 0..4 {
+            worst = worst.max(g[k].abs());
+            worst_warped = worst_warped.max(w[k].abs());
         }
     }
     eprintln!(
-        "largest in-plane gap: anticlastic {worst_in:.4}, warping alone {worst_in_warped:.4}"
+        "largest gap in f1 … f4 (%): anticlastic {worst:.3}, warping alone {worst_warped:.3}"
     );
-    assert!(
-        worst_in < 0.01 && worst_in_warped > 0.03,
-        "{worst_in} {worst_in_warped}"
-    );
+    assert!(worst < 2.0 && worst_warped > 3.0, "{worst} {worst_warped}");
 }
