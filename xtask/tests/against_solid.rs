@@ -5,7 +5,23 @@
 //! below it.
 
 use xtask::progress::Progress;
-use xtask::solid6::{run, stored_solids, strokes};
+use xtask::solid6::{run, stored_solids, strokes, BeamModel};
+
+/// Two guidance scenes (`(name, fixture, n)`) swept in parallel through the
+/// strokes `xs`.
+fn run_pair(
+    xs: &[f64],
+    a: (&str, &str, Option<usize>),
+    b: (&str, &str, Option<usize>),
+) -> (BeamModel, BeamModel) {
+    let root = xtask::workspace_root();
+    let pg = Progress::hidden();
+    let (ra, rb) = rayon::join(
+        || run(&root, a.0, a.1, a.2, xs, &pg),
+        || run(&root, b.0, b.1, b.2, xs, &pg),
+    );
+    (ra.unwrap(), rb.unwrap())
+}
 
 #[test]
 fn the_warping_guidance_holds_the_solid_curves_within_2_percent() {
@@ -13,30 +29,11 @@ fn the_warping_guidance_holds_the_solid_curves_within_2_percent() {
     let (solid, _) = stored_solids(&root).unwrap();
     let xs = strokes(&solid);
     assert!(xs.len() >= 5 && xs.last() > Some(&0.08), "{xs:?}");
-    let pg = Progress::hidden();
-    let (plain, warped) = rayon::join(
-        || {
-            run(
-                &root,
-                "beams n = 20",
-                "straight_guidance_spatial.ron",
-                Some(20),
-                &xs,
-                &pg,
-            )
-        },
-        || {
-            run(
-                &root,
-                "warping",
-                "straight_guidance_spatial_warping.ron",
-                None,
-                &xs,
-                &pg,
-            )
-        },
+    let (plain, warped) = run_pair(
+        &xs,
+        ("beams n = 20", "straight_guidance_spatial.ron", Some(20)),
+        ("warping", "straight_guidance_spatial_warping.ron", None),
     );
-    let (plain, warped) = (plain.unwrap(), warped.unwrap());
     let mut worst = [0.0f64; 2];
     let mut worst_plain = [0.0f64; 2];
     for (i, (x, s)) in solid.points.iter().enumerate() {
@@ -78,30 +75,15 @@ fn the_anticlastic_guidance_holds_the_physical_solid_within_2_percent() {
     let solid = physical.expect("fixtures/curves/solid/solid_guidance_nu03_50x8x2.csv");
     let xs = strokes(&solid);
     assert!(xs.len() >= 5 && xs.last() > Some(&0.08), "{xs:?}");
-    let pg = Progress::hidden();
-    let (warped, curled) = rayon::join(
-        || {
-            run(
-                &root,
-                "warping",
-                "straight_guidance_spatial_warping.ron",
-                None,
-                &xs,
-                &pg,
-            )
-        },
-        || {
-            run(
-                &root,
-                "anticlastic",
-                "straight_guidance_spatial_anticlastic.ron",
-                None,
-                &xs,
-                &pg,
-            )
-        },
+    let (warped, curled) = run_pair(
+        &xs,
+        ("warping", "straight_guidance_spatial_warping.ron", None),
+        (
+            "anticlastic",
+            "straight_guidance_spatial_anticlastic.ron",
+            None,
+        ),
     );
-    let (warped, curled) = (warped.unwrap(), curled.unwrap());
     assert_eq!(curled.dofs, 308);
     let (mut worst, mut worst_warped) = (0.0f64, 0.0f64);
     for (i, (x, s)) in solid.points.iter().enumerate() {

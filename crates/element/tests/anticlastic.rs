@@ -15,6 +15,13 @@ fn steel() -> Material {
     Material::from_poisson(2.1e11, 0.3, 7600.0)
 }
 
+/// The overlay of a beam from (0, 0, 0) to (L, 0, 0) (local y along global y).
+fn overlay(shape: SectionShape, q: [f64; 3], inertia: bool) -> Result<Element, ElementError> {
+    anticlastic_overlay([0.0; 3], q, [0.0, 1.0, 0.0], &steel(), &shape, inertia)
+}
+
+const SHEET: SectionShape = SectionShape::Rectangle { by: B, bz: T };
+
 /// The node coordinates of the element from (0, 0, 0) to (L, 0, 0) with its
 /// ends turned by ∓φ about global y (the weak axis: local y is global y,
 /// the 1 mm side along local z): a uniform curvature 2φ/L.
@@ -60,15 +67,7 @@ fn minimum(e: &Element, phi: f64) -> f64 {
 fn a_uniformly_bent_strip_has_ashwells_bending_energy() {
     let mat = steel();
     let nu = mat.poisson();
-    let e = anticlastic_overlay(
-        [0.0; 3],
-        [L, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        &mat,
-        &SectionShape::Rectangle { by: B, bz: T },
-        true,
-    )
-    .unwrap();
+    let e = overlay(SHEET, [L, 0.0, 0.0], true).unwrap();
     let ei = mat.e * B * T.powi(3) / 12.0;
     // β, the two-term Ritz factor and the converged one (anticlastic.py)
     for (beta, ritz2, exact) in [
@@ -105,15 +104,7 @@ fn a_twisted_flat_strip_stiffens_only_with_the_trapeze_term() {
     // no curvature: the curl stays zero and the overlay's energy is the
     // trapeze (Buckley) term of the twist, (E t b⁵/1440) τ⁴ per length
     let mat = steel();
-    let e = anticlastic_overlay(
-        [0.0; 3],
-        [L, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        &mat,
-        &SectionShape::Rectangle { by: B, bz: T },
-        false,
-    )
-    .unwrap();
+    let e = overlay(SHEET, [L, 0.0, 0.0], false).unwrap();
     let tau = 3.0; // rad/m
     let psi = tau * L;
     let (c, s) = ((psi / 2.0).cos(), (psi / 2.0).sin());
@@ -129,25 +120,8 @@ fn a_twisted_flat_strip_stiffens_only_with_the_trapeze_term() {
 
 #[test]
 fn the_overlay_refuses_what_is_not_a_sheet() {
-    let mat = steel();
-    let err = anticlastic_overlay(
-        [0.0; 3],
-        [L, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        &mat,
-        &SectionShape::Circle { d: 0.01 },
-        true,
-    )
-    .unwrap_err();
+    let err = overlay(SectionShape::Circle { d: 0.01 }, [L, 0.0, 0.0], true).unwrap_err();
     assert!(err.to_string().contains("Rectangle"), "{err}");
-    let err = anticlastic_overlay(
-        [0.0; 3],
-        [0.0; 3],
-        [0.0, 1.0, 0.0],
-        &mat,
-        &SectionShape::Rectangle { by: B, bz: T },
-        true,
-    )
-    .unwrap_err();
+    let err = overlay(SHEET, [0.0; 3], true).unwrap_err();
     assert!(err.to_string().contains("no length"), "{err}");
 }

@@ -3,7 +3,10 @@
 //! elements in their own group, restrained ends, the curl amplitudes as DOFs,
 //! and bad input that names the element.
 
-use flexmb_model::{Mechanism, Scene, XRole};
+mod common;
+
+use common::build;
+use flexmb_model::XRole;
 
 fn scene(opts: &str, section: &str, dimension: &str) -> String {
     let (at_b, up) = if dimension == "Spatial" {
@@ -30,12 +33,6 @@ fn scene(opts: &str, section: &str, dimension: &str) -> String {
 }
 
 const SHEET: &str = "Rectangle(by: 0.03, bz: 0.001)";
-
-fn build(text: &str) -> Result<Mechanism, String> {
-    Scene::from_ron_str(text)
-        .and_then(|s| s.build(None))
-        .map_err(|e| e.to_string())
-}
 
 #[test]
 fn a_sheet_chain_gets_two_curl_amplitudes_per_node_as_dofs() {

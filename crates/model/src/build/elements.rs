@@ -222,7 +222,7 @@ impl Expander<'_> {
         let chain = chain_nodes(id, &b.nodes, &p, &q, b.n, &mut nodes.at, &mut nodes.order)?;
         for (k, (a, bb)) in chain.iter().enumerate() {
             let (pa, pb) = (&self.nodes.at[a], &self.nodes.at[bb]);
-            let (element, frame) = match self.dim {
+            let (element, frame, overlay) = match self.dim {
                 Dimension::Planar => {
                     let (dx, dy) = (pb[0] - pa[0], pb[1] - pa[1]);
                     let l = dx.hypot(dy);
@@ -234,7 +234,8 @@ impl Expander<'_> {
                     let element =
                         Element::planar_beam([pa[0], pa[1]], [pb[0], pb[1]], &mat, &shape, &opts)
                             .map_err(element_error(id))?;
-                    (element, [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+                    let frame = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+                    (element, frame, None)
                 }
                 Dimension::Spatial => {
                     let axis = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
@@ -254,7 +255,21 @@ impl Expander<'_> {
                     // the element checked the axis and up
                     let frame =
                         flexmb_element::frame_from_axis(&axis, &up).map_err(element_error(id))?;
-                    (element, frame)
+                    let overlay = if curl_groups.is_empty() {
+                        None
+                    } else {
+                        let o = flexmb_element::anticlastic_overlay(
+                            [pa[0], pa[1], pa[2]],
+                            [pb[0], pb[1], pb[2]],
+                            up,
+                            &mat,
+                            &shape,
+                            b.mass,
+                        )
+                        .map_err(element_error(id))?;
+                        Some(o)
+                    };
+                    (element, frame, overlay)
                 }
             };
             let section = crate::BeamSection {
@@ -273,22 +288,7 @@ impl Expander<'_> {
                 attach.push(Attach::Group(warp_groups[k + 1].clone()));
             }
             let member = member_id(id, b.n, k);
-            if !curl_groups.is_empty() {
-                let (pa, pb) = (&self.nodes.at[a], &self.nodes.at[bb]);
-                let axis = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
-                let up = match &b.up {
-                    Some(u) => vec3(ctx, "up", u)?,
-                    None => default_up(&axis),
-                };
-                let overlay = flexmb_element::anticlastic_overlay(
-                    [pa[0], pa[1], pa[2]],
-                    [pb[0], pb[1], pb[2]],
-                    up,
-                    &mat,
-                    &shape,
-                    b.mass,
-                )
-                .map_err(element_error(id))?;
+            if let Some(overlay) = overlay {
                 let mut curl_attach = attach[..4].to_vec();
                 curl_attach.push(Attach::Group(curl_groups[k].clone()));
                 curl_attach.push(Attach::Group(curl_groups[k + 1].clone()));
