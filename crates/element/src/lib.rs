@@ -41,6 +41,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod anticlastic;
 mod beam_matrices;
 mod custom;
 mod element;
@@ -53,6 +54,7 @@ mod section;
 mod superelement;
 mod warping;
 
+pub use anticlastic::{anticlastic_overlay, ANTICLASTIC_NAMES, ANTICLASTIC_TYPE};
 pub use beam_matrices::{
     equivalent_stiffness, planar_beam_m_bar, planar_beam_s_bar, shear_parameter, spatial_a_diag,
     spatial_beam_m_bar, spatial_beam_s_bar,

@@ -270,7 +270,12 @@ fn greedy(
             if scene.dofs == DofChoice::Deformations {
                 let mut real = vec![false; mech.n_eps()];
                 for e in &mech.elements {
-                    if e.element.type_name() != "Euler-parameter normalization" {
+                    // the anticlastic overlay's deformations are energy
+                    // measures of its curl amplitudes (which become nodal
+                    // DOFs below), not a description of the motion
+                    let t = e.element.type_name();
+                    if t != "Euler-parameter normalization" && t != flexmb_element::ANTICLASTIC_TYPE
+                    {
                         for r in &mut real[e.eps_offset..e.eps_offset + e.element.n_eps()] {
                             *r = true;
                         }

@@ -169,9 +169,21 @@ pub struct BeamSpec {
     /// `None`: the thesis's beam (St-Venant torsion, free warping).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub warping: Option<WarpingSpec>,
+    /// Spatial `Rectangle` sheets only: the anticlastic curl (the Poisson
+    /// share of the weak-axis bending, `flexmb_element::anticlastic_overlay`),
+    /// two curl amplitudes (1/m) per node of the chain in two-mode groups
+    /// `ID.a0` … `ID.aN` shared by neighbouring elements. `p` and `q` say
+    /// what the chain's end groups are, as for `warping`: `Restrained` where
+    /// the sheet meets a clamp or a rigid body (its edge stays straight),
+    /// `Free` at a free end, `Shared` where two sheets continue each other.
+    /// Poisson's ratio is the material's, E/(2G) − 1. Default `None`: the
+    /// thesis's beam (free curl everywhere, EI).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anticlastic: Option<WarpingSpec>,
 }
 
-/// The warping ends of a beam chain ([`BeamSpec::warping`]).
+/// The ends of a beam chain's warping or curl coordinates
+/// ([`BeamSpec::warping`], [`BeamSpec::anticlastic`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WarpingSpec {

@@ -2,6 +2,9 @@
 //! one-coordinate mode groups `ID.w0` … `ID.wN` of a chain, restrained and
 //! shared ends, and bad input that names the element.
 
+mod common;
+
+use common::build;
 use flexmb_model::{Mechanism, Scene, XRole};
 use std::path::Path;
 
@@ -24,12 +27,6 @@ fn scene(w1: &str, w2: &str, section: &str) -> String {
 }
 
 const SHEET: &str = "Rectangle(by: 0.03, bz: 0.001)";
-
-fn build(text: &str) -> Result<Mechanism, String> {
-    Scene::from_ron_str(text)
-        .and_then(|s| s.build(None))
-        .map_err(|e| e.to_string())
-}
 
 fn group<'a>(m: &'a Mechanism, g: &str) -> &'a [usize] {
     &m.mode_groups

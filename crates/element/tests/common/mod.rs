@@ -201,6 +201,25 @@ pub fn catalogue(rng: &mut StdRng) -> Vec<(String, Element)> {
         "spatial beam with warping (nodes start rotated)".into(),
         warping_rotated,
     ));
+    // the anticlastic overlay of a sheet, weak about local y and about local z
+    for (name, by, bz) in [("y", 0.03, 0.002), ("z", 0.002, 0.03)] {
+        let sheet = SectionShape::Rectangle { by, bz };
+        let curl = flexmb_element::anticlastic_overlay(
+            [0.1, 0.2, -0.1],
+            [0.3, 0.1, 0.05],
+            [0.0, 0.0, 1.0],
+            &mat,
+            &sheet,
+            true,
+        )
+        .unwrap();
+        let rotated = start_rotated(&mut self::rng(0xc011), &curl);
+        v.push((format!("anticlastic overlay (weak about {name})"), curl));
+        v.push((
+            format!("anticlastic overlay (weak about {name}, nodes start rotated)"),
+            rotated,
+        ));
+    }
     v
 }
 

@@ -196,6 +196,7 @@ impl Expander<'_> {
             inertia: b.mass,
             velocity_transform: b.transform,
             warping: b.warping.is_some(),
+            plate_warping: b.anticlastic.is_some(),
         };
         let warp_groups = match &b.warping {
             None => vec![],
@@ -205,24 +206,23 @@ impl Expander<'_> {
                     "warping is an option of spatial beams; a planar beam has no torsion",
                 ))
             }
-            Some(w) => {
-                let groups = warping_groups(id, b.n, w);
-                for g in &groups {
-                    register_mode_group(&mut self.set.mode_groups, ctx, g, 1)?;
-                }
-                for (end, g) in [(&w.p, &groups[0]), (&w.q, &groups[b.n])] {
-                    if *end == WarpingEnd::Restrained {
-                        self.set.restrained.push(Select::Modes(g.clone()));
-                    }
-                }
-                groups
+            Some(w) => self.end_groups(ctx, id, b.n, w, "w", 1)?,
+        };
+        let curl_groups = match &b.anticlastic {
+            None => vec![],
+            Some(_) if self.dim == Dimension::Planar => {
+                return Err(ModelError::invalid(
+                    ctx,
+                    "anticlastic is an option of spatial sheet beams; a planar beam has no section height",
+                ))
             }
+            Some(w) => self.end_groups(ctx, id, b.n, w, "a", 2)?,
         };
         let nodes = &mut *self.nodes;
         let chain = chain_nodes(id, &b.nodes, &p, &q, b.n, &mut nodes.at, &mut nodes.order)?;
         for (k, (a, bb)) in chain.iter().enumerate() {
             let (pa, pb) = (&self.nodes.at[a], &self.nodes.at[bb]);
-            let (element, frame) = match self.dim {
+            let (element, frame, overlay) = match self.dim {
                 Dimension::Planar => {
                     let (dx, dy) = (pb[0] - pa[0], pb[1] - pa[1]);
                     let l = dx.hypot(dy);
@@ -234,7 +234,8 @@ impl Expander<'_> {
                     let element =
                         Element::planar_beam([pa[0], pa[1]], [pb[0], pb[1]], &mat, &shape, &opts)
                             .map_err(element_error(id))?;
-                    (element, [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+                    let frame = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+                    (element, frame, None)
                 }
                 Dimension::Spatial => {
                     let axis = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
@@ -254,7 +255,21 @@ impl Expander<'_> {
                     // the element checked the axis and up
                     let frame =
                         flexmb_element::frame_from_axis(&axis, &up).map_err(element_error(id))?;
-                    (element, frame)
+                    let overlay = if curl_groups.is_empty() {
+                        None
+                    } else {
+                        let o = flexmb_element::anticlastic_overlay(
+                            [pa[0], pa[1], pa[2]],
+                            [pb[0], pb[1], pb[2]],
+                            up,
+                            &mat,
+                            &shape,
+                            b.mass,
+                        )
+                        .map_err(element_error(id))?;
+                        Some(o)
+                    };
+                    (element, frame, overlay)
                 }
             };
             let section = crate::BeamSection {
@@ -272,9 +287,46 @@ impl Expander<'_> {
                 attach.push(Attach::Group(warp_groups[k].clone()));
                 attach.push(Attach::Group(warp_groups[k + 1].clone()));
             }
-            self.push_section(member_id(id, b.n, k), id, element, attach, Some(section));
+            let member = member_id(id, b.n, k);
+            if let Some(overlay) = overlay {
+                let mut curl_attach = attach[..4].to_vec();
+                curl_attach.push(Attach::Group(curl_groups[k].clone()));
+                curl_attach.push(Attach::Group(curl_groups[k + 1].clone()));
+                // its own group `ID.curl`: `Def("ID", …)` keeps naming the beams
+                self.push(
+                    format!("{member}.curl"),
+                    &format!("{id}.curl"),
+                    overlay,
+                    curl_attach,
+                );
+            }
+            self.push_section(member, id, element, attach, Some(section));
         }
         Ok(())
+    }
+
+    /// The one-per-node mode groups of a chain's warping (`w`) or curl
+    /// (`a`) coordinates, `size` coordinates each, registered, with the
+    /// `Restrained` ends fixed.
+    fn end_groups(
+        &mut self,
+        ctx: &str,
+        id: &str,
+        n: usize,
+        w: &WarpingSpec,
+        letter: &str,
+        size: usize,
+    ) -> Result<Vec<String>, ModelError> {
+        let groups = chain_groups(id, n, w, letter);
+        for g in &groups {
+            register_mode_group(&mut self.set.mode_groups, ctx, g, size)?;
+        }
+        for (end, g) in [(&w.p, &groups[0]), (&w.q, &groups[n])] {
+            if *end == WarpingEnd::Restrained {
+                self.set.restrained.push(Select::Modes(g.clone()));
+            }
+        }
+        Ok(groups)
     }
 
     /// A truss or a chain of trusses.
@@ -550,14 +602,14 @@ impl Expander<'_> {
     }
 }
 
-/// The warping groups of a beam chain of `n` elements, one per node: the
-/// ends' `Shared` names, else `ID.w0` … `ID.wN`.
-fn warping_groups(id: &str, n: usize, w: &WarpingSpec) -> Vec<String> {
+/// The warping (`letter` w) or curl (a) groups of a beam chain of `n`
+/// elements, one per node: the ends' `Shared` names, else `ID.w0` … `ID.wN`.
+fn chain_groups(id: &str, n: usize, w: &WarpingSpec, letter: &str) -> Vec<String> {
     (0..=n)
         .map(|k| match (k, &w.p, &w.q) {
             (0, WarpingEnd::Shared(g), _) => g.clone(),
             (k, _, WarpingEnd::Shared(g)) if k == n => g.clone(),
-            _ => format!("{id}.w{k}"),
+            _ => format!("{id}.{letter}{k}"),
         })
         .collect()
 }
