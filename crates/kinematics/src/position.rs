@@ -284,7 +284,7 @@ impl Kinematics {
         match s {
             None => c.xi.copy_from_slice(target),
             // (the last step to the target itself, not to a rounding of it)
-            Some(s) if s == 1.0 => c.xi.copy_from_slice(target),
+            Some(1.0) => c.xi.copy_from_slice(target),
             Some(s) => {
                 for ((xi, a), b) in c.xi.iter_mut().zip(&c.xi_good).zip(target) {
                     *xi = a + s * (b - a);
