@@ -280,51 +280,26 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
         .iter()
         .map(|t| [refs[0].value(*t), refs[1].value(*t)])
         .collect();
-    let reference = s_of_t
-        .iter()
-        .map(|s| {
-            let mut z = vec![0.0; kin_model.n_z()];
-            z[0] = *s;
-            let q = kin_model.full_coordinates(&z);
-            let dy = kin_model.dynamics_mut();
-            dy.kinematics_mut()
-                .solve(&q, 0.0)
-                .map_err(|e| e.to_string())?;
-            Ok(ch7::end_effector(&mech, dy.kinematics().x()))
-        })
-        .collect::<Result<Vec<_>, String>>()?;
-    let mut runs = vec![];
-    let adams = |rtol: f64| {
-        let mut o = SimulationOptions::new(Integrator::Adams, 0.0, ch7::T_END, ch7::OUTPUTS);
-        o.rtol = rtol;
-        o.atol = rtol * 1e-3;
-        o
+    let n_z = kin_model.n_z();
+    let z_of = |s: f64| {
+        let mut z = vec![0.0; n_z];
+        z[0] = s;
+        z
     };
+    let reference = reference_end_effector(&mut kin_model, &s_of_t, &z_of)?;
+    let mut runs = vec![];
     for (label, from_equilibrium) in [
         ("IBM-u from the undeflected configuration", false),
         ("IBM-u from the gravity equilibrium", true),
     ] {
         let mut model = ch7::reduced(&cmech, ibm_u)?;
-        let mut z = z0.clone();
-        if from_equilibrium {
-            let eq = MechanicalModel::static_equilibrium(
-                &mut model,
-                0.0,
-                &z,
-                &flexmb_dynamics::StaticOptions::default(),
-            )
-            .map_err(|e| format!("the gravity equilibrium of IBM-u: {e}"))?;
-            z = eq.coordinates;
-        }
-        let bar = pg.bar(label, 1000);
-        let tr =
-            MechanicalModel::simulate(&mut model, 0.0, &z, &z0, &adams(1e-3), &mut |t, _, _| {
-                bar.set((t / ch7::T_END * 1000.0) as u64);
-                Control::Continue
-            })
-            .map_err(|e| format!("{label}: {e}"))?;
-        bar.finish();
-        runs.push(run_of(label, &cmech, &tr.full));
+        runs.push(reduced_closed_loop(
+            &mut model,
+            &z0,
+            from_equilibrium,
+            label,
+            pg,
+        )?);
     }
     // 6. the unreduced closed loop, generalized-α, within its budget
     let stop = Arc::new(AtomicBool::new(false));
@@ -371,6 +346,63 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
         angles,
         s_of_t,
     })
+}
+
+/// The end-effector (x, y, z) of the reduced model `kin` (no gravity) with
+/// η ≡ 0 at the arc lengths `s`, at z = `z_of(s)`: the reference path the
+/// controllers' angle references describe.
+pub fn reference_end_effector(
+    kin: &mut flexmb_reduction::ReducedModel,
+    s: &[f64],
+    z_of: &dyn Fn(f64) -> Vec<f64>,
+) -> Result<Vec<[f64; 3]>, String> {
+    s.iter()
+        .map(|s| {
+            let q = kin.full_coordinates(&z_of(*s));
+            let dy = kin.dynamics_mut();
+            dy.kinematics_mut()
+                .solve(&q, 0.0)
+                .map_err(|e| e.to_string())?;
+            Ok(ch7::end_effector(dy.mechanism(), dy.kinematics().x()))
+        })
+        .collect()
+}
+
+/// The closed loop of a reduced `model` (of the mechanism with gravity and
+/// the PD controllers) over [`ch7::T_END`] with [`ch7::OUTPUTS`] outputs,
+/// Adams (rtol 1e-3, atol 1e-6), from `z0` at rest, or from the gravity
+/// equilibrium next to it if `from_equilibrium`, with a progress bar.
+pub fn reduced_closed_loop(
+    model: &mut flexmb_reduction::ReducedModel,
+    z0: &[f64],
+    from_equilibrium: bool,
+    label: &str,
+    pg: &Progress,
+) -> Result<Run, String> {
+    let mut z = z0.to_vec();
+    if from_equilibrium {
+        let eq = MechanicalModel::static_equilibrium(
+            model,
+            0.0,
+            &z,
+            &flexmb_dynamics::StaticOptions::default(),
+        )
+        .map_err(|e| format!("the gravity equilibrium of {label}: {e}"))?;
+        z = eq.coordinates;
+    }
+    let mut o = SimulationOptions::new(Integrator::Adams, 0.0, ch7::T_END, ch7::OUTPUTS);
+    o.rtol = 1e-3;
+    o.atol = 1e-6;
+    let bar = pg.bar(label, 1000);
+    let rest = vec![0.0; z.len()];
+    let tr = MechanicalModel::simulate(model, 0.0, &z, &rest, &o, &mut |t, _, _| {
+        bar.set((t / ch7::T_END * 1000.0) as u64);
+        Control::Continue
+    })
+    .map_err(|e| format!("{label}: {e}"))?;
+    bar.finish();
+    let mech = model.dynamics().mechanism().clone();
+    Ok(run_of(label, &mech, &tr.full))
 }
 
 /// Writes the report of chapter 7 into `out`.
