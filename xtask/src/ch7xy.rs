@@ -14,13 +14,15 @@
 //! n_z = 2 + 6 = 8, as the one-coordinate models.
 
 use crate::ch4::path::{Path4, RADIUS};
-use crate::ch4::sweep;
 use crate::ch7;
 use faer::Mat;
-use flexmb_linearize::{sweep_until, SweepOptions, SweepParameter, SweepPoint};
+use flexmb_dynamics::{Dynamics, StaticOptions};
+use flexmb_linearize::{undamped_modes, SweepPoint};
 use flexmb_model::{Mechanism, TimeFunction};
 use flexmb_reduction::{orthonormalize, GridBasis};
+use rayon::prelude::*;
 use std::f64::consts::PI;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// The half width of the square workspace about the undeflected position
@@ -60,30 +62,77 @@ pub fn halton_points(count: usize) -> Vec<[f64; 2]> {
         .collect()
 }
 
-/// A polyline through the end-effector offsets `points` (from the
-/// undeflected position), parametrized by its arc length: the path of a
-/// sweep that visits them in this order, starting at the undeflected
-/// position. Returns the arc lengths of the points and the path.
-fn polyline(points: &[[f64; 2]]) -> (Vec<f64>, Vec<[f64; 2]>, Vec<f64>) {
-    let mut nodes = vec![[0.0, 0.0]];
-    nodes.extend_from_slice(points);
-    let mut s = vec![0.0];
-    for w in nodes.windows(2) {
-        let d = (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]);
-        s.push(s.last().copied().unwrap_or(0.0) + d);
+/// The longest step (m) between consecutive equilibria of
+/// [`held_equilibria`]'s continuation: longer legs get intermediate
+/// equilibria (without modes). Measured: with steps
+/// up to 25 mm, some solves failed at once (from the undeflected position
+/// to (0, −25) mm or (−16.7, −16.7) mm: "element hf_x1.main.clamp_b has
+/// flipped" at the smallest load increment) while others of 50 mm
+/// converged; with 5 mm steps all did. 6.5 mm: one step per cell of the
+/// 17 × 17 grid (6.25 mm), about the path sweep's 4.3 mm of chapter 7.
+pub const MAX_STEP: f64 = 0.0065;
+
+/// A polyline from the undeflected position through the end-effector
+/// offsets `points`, and the sweep values (arc lengths) that walk along it
+/// in steps of at most [`MAX_STEP`]: the first at the undeflected position
+/// itself, and for each point the index of its value.
+struct Polyline {
+    nodes: Vec<[f64; 2]>,
+    arc: Vec<f64>,
+    values: Vec<f64>,
+    of_point: Vec<usize>,
+}
+
+impl Polyline {
+    fn new(points: &[[f64; 2]]) -> Self {
+        let mut nodes = vec![[0.0, 0.0]];
+        nodes.extend_from_slice(points);
+        let mut arc = vec![0.0];
+        let (mut values, mut of_point) = (vec![0.0], vec![]);
+        for w in nodes.windows(2) {
+            let a0 = arc.last().copied().unwrap_or(0.0);
+            let d = (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]);
+            let steps = (d / MAX_STEP).ceil().max(1.0) as usize;
+            values.extend((1..=steps).map(|k| a0 + d * k as f64 / steps as f64));
+            of_point.push(values.len() - 1);
+            arc.push(a0 + d);
+        }
+        Self {
+            nodes,
+            arc,
+            values,
+            of_point,
+        }
     }
-    (s[1..].to_vec(), nodes, s)
+
+    /// The offset at arc length s.
+    fn at(&self, s: f64) -> [f64; 2] {
+        let arc = &self.arc;
+        let k = arc.partition_point(|a| *a <= s).clamp(1, arc.len() - 1);
+        let t = if arc[k] > arc[k - 1] {
+            ((s - arc[k - 1]) / (arc[k] - arc[k - 1])).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let (a, b) = (self.nodes[k - 1], self.nodes[k]);
+        [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+    }
 }
 
 /// The equilibria of the mechanism (no gravity) with the end-effector held
 /// at the offsets `points` from its undeflected position, with `modes`
-/// modes each (shapes and masses kept), in the order given: one
+/// modes each (shapes and masses kept), in the order given. Phase 1: one
 /// continuation along the polyline through them from the undeflected
-/// position (so consecutive points should be near each other: a grid is
-/// visited row by row, back and forth), the linearizations in parallel
-/// (rayon). `progress(done, total)` as in the sweeps. A point that
-/// repeats the previous one is refused by the sweep (its arc length does
-/// not grow).
+/// position, in steps of at most [`MAX_STEP`] (so consecutive points
+/// should be near each other: a grid is visited row by row, back and
+/// forth), each static solve from the last equilibrium. Phase 2: the rest
+/// linearization (E.6) and the modes of the requested points only, in
+/// parallel (rayon), each from its equilibrium's own configuration. The
+/// points' `s` is their arc length along the polyline.
+/// `progress(done, total)` counts the intermediate equilibria too. An
+/// error names the point whose equilibrium failed, and a static solve that
+/// switched an Euler chart or the dependent coordinates (the points would
+/// be in other DOFs; not met in the workspace).
 pub fn held_equilibria(
     mech: &Arc<Mechanism>,
     dofs: [usize; 2],
@@ -91,30 +140,59 @@ pub fn held_equilibria(
     modes: usize,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<SweepPoint>, String> {
-    let (values, nodes, arc) = polyline(points);
+    let line = Polyline::new(points);
     let q0 = mech.q0();
     let (x0, y0) = (q0[dofs[0]], q0[dofs[1]]);
-    let param = SweepParameter::Path {
-        dofs: dofs.to_vec(),
-        path: Box::new(move |s| {
-            let k = arc.partition_point(|a| *a <= s).clamp(1, arc.len() - 1);
-            let t = if arc[k] > arc[k - 1] {
-                ((s - arc[k - 1]) / (arc[k] - arc[k - 1])).clamp(0.0, 1.0)
-            } else {
-                1.0
-            };
-            let (a, b) = (nodes[k - 1], nodes[k]);
-            vec![x0 + a[0] + t * (b[0] - a[0]), y0 + a[1] + t * (b[1] - a[1])]
-        }),
-    };
-    let opts = SweepOptions {
-        values,
-        modes,
-        t: 0.0,
-        keep_vectors: true,
-    };
-    let o = sweep_until(mech, &param, &opts, progress, None).map_err(|e| e.to_string())?;
-    Ok(o.points)
+    let total = line.values.len() + points.len();
+    let mut dy = Dynamics::new(mech.clone());
+    let mut q = q0.clone();
+    let mut found = Vec::with_capacity(points.len());
+    for (i, s) in line.values.iter().enumerate() {
+        let p = line.at(*s);
+        let so = StaticOptions {
+            ramp_loads: i == 0,
+            held: vec![(dofs[0], x0 + p[0]), (dofs[1], y0 + p[1])],
+            ..Default::default()
+        };
+        let at = || format!("({:.2}, {:.2}) mm", 1e3 * p[0], 1e3 * p[1]);
+        let sol = dy
+            .static_equilibrium(0.0, &q, &so)
+            .map_err(|e| format!("the end-effector held at {}: {e}", at()))?;
+        if !sol.chart_switches.is_empty() || !sol.partition_switches.is_empty() {
+            return Err(format!(
+                "the end-effector held at {}: the static solve changed the DOFs (an Euler \
+                 chart or the dependent coordinates)",
+                at()
+            ));
+        }
+        q = sol.q;
+        if line.of_point.get(found.len()) == Some(&i) {
+            found.push((*s, q.clone(), sol.x, sol.reactions));
+        }
+        progress(i + 1, total);
+    }
+    let done = AtomicUsize::new(line.values.len());
+    found
+        .par_iter()
+        .map_init(
+            || Dynamics::new(mech.clone()),
+            |dy, (s, q, x, holding)| {
+                dy.kinematics_mut().set_guess(x);
+                let lin = dy.linearize_at_rest(0.0, q).map_err(|e| e.to_string())?;
+                let m = undamped_modes(&lin, modes).map_err(|e| e.to_string())?;
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                Ok(SweepPoint {
+                    s: *s,
+                    q: q.clone(),
+                    holding: holding.clone(),
+                    x: x.clone(),
+                    frequencies_hz: m.frequencies_hz(),
+                    modes: Some(m.vectors),
+                    mass: Some(lin.m),
+                })
+            },
+        )
+        .collect()
 }
 
 /// The grid points of an n × n grid in the order index i + n j (x
@@ -289,16 +367,20 @@ pub fn circle_equilibria(
 }
 
 /// Equilibria on the path (4.1) at `n` arc lengths halfway between n + 1
-/// equally spaced ones (off the ch7 references).
+/// equally spaced ones (off the ch7 references), reached along the chords
+/// between them.
 pub fn path_equilibria(
     mech: &Arc<Mechanism>,
     dofs: [usize; 2],
     n: usize,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Vec<SweepPoint>, String> {
-    let l = Path4::new().length();
-    let values: Vec<f64> = (0..n).map(|i| l * (i as f64 + 0.5) / n as f64).collect();
-    sweep::run(mech, dofs, &values, ch7::R, progress)
+    let path = Path4::new();
+    let l = path.length();
+    let pts: Vec<[f64; 2]> = (0..n)
+        .map(|i| path.at(l * (i as f64 + 0.5) / n as f64).0)
+        .collect();
+    held_equilibria(mech, dofs, &pts, ch7::R, progress)
 }
 
 #[cfg(test)]

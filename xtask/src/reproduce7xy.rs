@@ -40,10 +40,10 @@ pub struct XyOptions {
 impl Default for XyOptions {
     fn default() -> Self {
         Self {
-            finest: 17,
-            checks: 64,
-            path_checks: 24,
-            circle_points: 24,
+            finest: 9,
+            checks: 32,
+            path_checks: 12,
+            circle_points: 16,
             closed_loop: true,
         }
     }

@@ -1,0 +1,86 @@
+//! The two-coordinate interpolated basis of the chapter-7 mechanism (issue
+//! 18, beyond the thesis) on the small study that CI affords
+//! ([`reproduce7xy::ci_options`]: grids 2 × 2, 3 × 3 and 5 × 5, 16 Halton
+//! check points over the workspace, 6 on the path (4.1)), and its stored
+//! curves (`fixtures/curves/ch7xy`, `cargo xtask regress --chapter ch7xy`).
+//! `cargo xtask reproduce ch7xy` runs the full study up to 17 × 17.
+
+use std::sync::OnceLock;
+use xtask::ch7;
+use xtask::progress::Progress;
+use xtask::reproduce7xy::{self, errors, XyResults};
+
+fn study() -> &'static XyResults {
+    static R: OnceLock<XyResults> = OnceLock::new();
+    R.get_or_init(|| {
+        reproduce7xy::compute(
+            &xtask::workspace_root(),
+            &reproduce7xy::ci_options(),
+            &Progress::hidden(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+    })
+}
+
+#[test]
+fn the_stored_curves_are_reproduced() {
+    let r = study();
+    let rc = xtask::regress::Recomputed {
+        dir: reproduce7xy::curve_dir(&xtask::workspace_root()),
+        curves: reproduce7xy::stored_curves(r),
+        provenance: vec![],
+    };
+    assert_eq!(rc.curves.len(), 4, "unreduced and three grids");
+    let d = xtask::regress::check(&rc);
+    assert!(
+        d.is_empty(),
+        "{} differences (tolerance {:e}):\n{}",
+        d.len(),
+        xtask::regress::RTOL,
+        d.join("\n")
+    );
+}
+
+/// At its own grid points a grid model is the unreduced model's
+/// interpolation data: Q through the equilibria, V spanning the modes
+/// there, so ω3–ω8 agree to rounding (as the one-coordinate IBM-u at its
+/// references), and ω1, ω2 (Q,x and Q,y against the two mechanism modes)
+/// closely.
+#[test]
+fn a_grid_model_is_exact_at_its_own_grid_points() {
+    let r = study();
+    let m = r.models.last().expect("a grid model");
+    let z_of = |p: &flexmb_linearize::SweepPoint| xtask::ch7xy::z_at(&r.mech, r.dofs, p);
+    let f = ch7::reduced_frequencies_at(&r.mech, &m.basis, &r.grid, &z_of, r.dofs, ch7::R)
+        .unwrap_or_else(|e| panic!("{e}"));
+    for k in 2..ch7::R {
+        let e = errors(&r.grid, &f, k).into_iter().fold(0.0, f64::max);
+        assert!(e < 1e-6, "ω{} at the grid points: {e:.2e}", k + 1);
+    }
+    for k in 0..2 {
+        let e = errors(&r.grid, &f, k).into_iter().fold(0.0, f64::max);
+        assert!(e < 1e-2, "ω{} at the grid points: {e:.2e}", k + 1);
+    }
+}
+
+/// The curse of dimensionality, in small: the errors off the grid shrink
+/// as the grid is refined, for every mode, and the finest CI grid keeps
+/// ω3–ω8 within what the full study measured for 5 × 5.
+#[test]
+fn the_errors_off_the_grid_shrink_with_the_grid() {
+    let r = study();
+    assert_eq!(
+        r.models.iter().map(|m| m.n).collect::<Vec<_>>(),
+        vec![2, 3, 5]
+    );
+    for k in 0..ch7::R {
+        let e: Vec<f64> = r.models.iter().map(|m| m.worst_error(r, k)).collect();
+        assert!(
+            e[2] < e[0],
+            "ω{}: 5 × 5 {:.2e} against 2 × 2 {:.2e}",
+            k + 1,
+            e[2],
+            e[0]
+        );
+    }
+}
