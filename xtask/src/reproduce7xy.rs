@@ -94,6 +94,8 @@ pub struct XyResults {
     pub runs: Vec<Run>,
     /// The reference end-effector (x, y, z) at the outputs.
     pub reference: Vec<[f64; 3]>,
+    /// Why the closed loop failed, if it did.
+    pub closed_loop_error: Option<String>,
 }
 
 /// The grid sizes studied: 2, 3, 5, 9, … up to `finest` (each a sub-grid
@@ -229,10 +231,15 @@ pub fn compute(root: &Path, o: &XyOptions, pg: &Progress) -> Result<XyResults, S
     let circle = ch7xy::circle_equilibria(&mech, dofs, o.circle_points, &|d, _| bar.set(d as u64))?;
     bar.finish();
     let circle_reduced = ch7::reduced_frequencies_at(&mech, finest, &circle, &z_of, dofs, ch7::R)?;
-    let (runs, reference) = if o.closed_loop {
-        circle_closed_loop(root, &mech, finest, pg)?
+    // a closed loop that fails (a position solve or the integrator) is
+    // reported with its message, not fatal to the study
+    let (runs, reference, closed_loop_error) = if o.closed_loop {
+        match circle_closed_loop(root, &mech, finest, pg) {
+            Ok((r, refs)) => (r, refs, None),
+            Err(e) => (vec![], vec![], Some(e)),
+        }
     } else {
-        (vec![], vec![])
+        (vec![], vec![], None)
     };
     Ok(XyResults {
         mech,
@@ -246,6 +253,7 @@ pub fn compute(root: &Path, o: &XyOptions, pg: &Progress) -> Result<XyResults, S
         circle_reduced,
         runs,
         reference,
+        closed_loop_error,
     })
 }
 
@@ -623,6 +631,14 @@ fn report(o: &XyOptions, r: &XyResults, figs: &Figures, wall: f64) -> String {
     }
     let _ = writeln!(s, "{}", t.render());
     s += &figs.markdown(|f| f == "xy_circle_frequencies");
+    if let Some(e) = &r.closed_loop_error {
+        let _ = writeln!(
+            s,
+            "### Closed loop on the circle\n\nThe closed loop of the {0} × {0} grid model \
+             failed: {e}\n",
+            o.finest
+        );
+    }
     if !r.runs.is_empty() {
         let _ = writeln!(
             s,
