@@ -287,20 +287,7 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
         z
     };
     let reference = reference_end_effector(&mut kin_model, &s_of_t, &z_of)?;
-    let mut runs = vec![];
-    for (label, from_equilibrium) in [
-        ("IBM-u from the undeflected configuration", false),
-        ("IBM-u from the gravity equilibrium", true),
-    ] {
-        let mut model = ch7::reduced(&cmech, ibm_u)?;
-        runs.push(reduced_closed_loop(
-            &mut model,
-            &z0,
-            from_equilibrium,
-            label,
-            pg,
-        )?);
-    }
+    let mut runs = closed_loop_pair(&cmech, ibm_u, "IBM-u", pg)?;
     // 6. the unreduced closed loop, generalized-α, within its budget
     let stop = Arc::new(AtomicBool::new(false));
     let timer = {
@@ -534,31 +521,20 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
         p.push(Series::line(name, &t, &a));
     }
     figs.save(&p, out, "fig7_4_reference")?;
-    let mut p =
-        Plot::new("Fig. 7.5a: the end-effector in the plane", "x (m)", "y (m)").equal_aspect();
-    let xy = |e: &[[f64; 3]]| -> (Vec<f64>, Vec<f64>) { e.iter().map(|p| (p[0], p[1])).unzip() };
-    let (x, y) = xy(&r.reference);
-    p.push(Series::line("reference", &x, &y));
-    for run in &r.runs[..2] {
-        let (x, y) = xy(&run.ee);
-        p.push(Series::dashed(&run.label, &x, &y));
-    }
-    figs.save(&p, out, "fig7_5a_path")?;
-    let mut p = Plot::new(
-        "Fig. 7.5b: tracking errors of IBM-u (from the gravity equilibrium)",
-        "t (s)",
-        "error (m)",
-    );
-    for (k, name) in ["x_ref − x", "y_ref − y"].iter().enumerate() {
-        let e: Vec<f64> = r
-            .reference
-            .iter()
-            .zip(&r.runs[1].ee)
-            .map(|(a, b)| a[k] - b[k])
-            .collect();
-        p.push(Series::line(name, &t, &e));
-    }
-    figs.save(&p, out, "fig7_5b_errors")?;
+    tracking_figures(
+        figs,
+        out,
+        &r.reference,
+        &r.runs[..2],
+        &r.runs[1],
+        [
+            ("fig7_5a_path", "Fig. 7.5a: the end-effector in the plane"),
+            (
+                "fig7_5b_errors",
+                "Fig. 7.5b: tracking errors of IBM-u (from the gravity equilibrium)",
+            ),
+        ],
+    )?;
     let mut p = Plot::new("Fig. 7.6: z of the end-effector", "t (s)", "z (m)");
     for run in &r.runs {
         let z: Vec<f64> = run.ee.iter().map(|p| p[2]).collect();
@@ -579,6 +555,66 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
     ));
     figs.save(&p, out, "fig7_7_spectrum")?;
     Ok(())
+}
+
+/// Two figures of closed-loop `runs` against the `reference` end-effector
+/// path: the paths in the plane, and the x, y tracking errors of `tracked`
+/// over time; `names` are (file stem, title) of each.
+pub fn tracking_figures(
+    figs: &mut Figures,
+    out: &Path,
+    reference: &[[f64; 3]],
+    runs: &[Run],
+    tracked: &Run,
+    names: [(&str, &str); 2],
+) -> std::io::Result<()> {
+    let mut p = Plot::new(names[0].1, "x (m)", "y (m)").equal_aspect();
+    let xy = |e: &[[f64; 3]]| -> (Vec<f64>, Vec<f64>) { e.iter().map(|p| (p[0], p[1])).unzip() };
+    let (x, y) = xy(reference);
+    p.push(Series::line("reference", &x, &y));
+    for run in runs {
+        let (x, y) = xy(&run.ee);
+        p.push(Series::dashed(&run.label, &x, &y));
+    }
+    figs.save(&p, out, names[0].0)?;
+    let mut p = Plot::new(names[1].1, "t (s)", "error (m)");
+    for (k, name) in ["x_ref − x", "y_ref − y"].iter().enumerate() {
+        let e: Vec<f64> = reference
+            .iter()
+            .zip(&tracked.ee)
+            .map(|(a, b)| a[k] - b[k])
+            .collect();
+        p.push(Series::line(name, &tracked.t, &e));
+    }
+    figs.save(&p, out, names[1].0)
+}
+
+/// The closed loops of a reduced model of `cmech` (gravity, controllers)
+/// with `basis` from z = 0 at rest and from the gravity equilibrium next to
+/// it ([`reduced_closed_loop`]), labelled "`name` from …".
+pub fn closed_loop_pair<B: flexmb_reduction::Basis + Clone + 'static>(
+    cmech: &Arc<flexmb_model::Mechanism>,
+    basis: &B,
+    name: &str,
+    pg: &Progress,
+) -> Result<Vec<Run>, String> {
+    let z0 = vec![0.0; basis.n_z()];
+    [
+        ("the undeflected configuration", false),
+        ("the gravity equilibrium", true),
+    ]
+    .into_iter()
+    .map(|(from, from_equilibrium)| {
+        let mut model = ch7::reduced(cmech, basis)?;
+        reduced_closed_loop(
+            &mut model,
+            &z0,
+            from_equilibrium,
+            &format!("{name} from {from}"),
+            pg,
+        )
+    })
+    .collect()
 }
 
 /// The spectrum of z_eq − z_undef over the 1000 steps of the IBM-u runs.

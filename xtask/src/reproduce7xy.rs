@@ -11,7 +11,9 @@ use crate::curves::StoredCurve;
 use crate::models::CurvePoint;
 use crate::progress::Progress;
 use crate::report::{pct, sig, Figures, Table};
-use crate::reproduce7::{median_and_max, reduced_closed_loop, reference_end_effector, Run};
+use crate::reproduce7::{
+    closed_loop_pair, median_and_max, reference_end_effector, tracking_figures, Run,
+};
 use flexmb_linearize::SweepPoint;
 use flexmb_model::Mechanism;
 use flexmb_plot::{Plot, Series};
@@ -283,21 +285,7 @@ pub fn circle_closed_loop(
     let s_of_t: Vec<f64> = times.iter().map(|t| motion.value(*t)).collect();
     let reference = reference_end_effector(&mut kin, &s_of_t, &z_of)?;
     let (cmech, _) = ch7::mechanism(root, true, Some(&refs))?;
-    let z0 = vec![0.0; ch7::R];
-    let mut runs = vec![];
-    for (label, from_equilibrium) in [
-        ("grid model from the undeflected configuration", false),
-        ("grid model from the gravity equilibrium", true),
-    ] {
-        let mut model = ch7::reduced(&cmech, basis)?;
-        runs.push(reduced_closed_loop(
-            &mut model,
-            &z0,
-            from_equilibrium,
-            label,
-            pg,
-        )?);
-    }
+    let runs = closed_loop_pair(&cmech, basis, "grid model", pg)?;
     Ok((runs, reference))
 }
 
@@ -462,36 +450,23 @@ fn figures(r: &XyResults, out: &Path, figs: &mut Figures) -> std::io::Result<()>
     ));
     figs.save(&p, out, "xy_workspace")?;
     if let Some(run) = r.runs.last() {
-        let mut p = Plot::new(
-            "The grid model's closed loop on the off-centre circle",
-            "x (m)",
-            "y (m)",
-        )
-        .equal_aspect();
-        let xy =
-            |e: &[[f64; 3]]| -> (Vec<f64>, Vec<f64>) { e.iter().map(|p| (p[0], p[1])).unzip() };
-        let (x, y) = xy(&r.reference);
-        p.push(Series::line("reference", &x, &y));
-        for run in &r.runs {
-            let (x, y) = xy(&run.ee);
-            p.push(Series::dashed(&run.label, &x, &y));
-        }
-        figs.save(&p, out, "xy_closed_loop_path")?;
-        let mut p = Plot::new(
-            "Tracking errors of the grid model (from the gravity equilibrium)",
-            "t (s)",
-            "error (m)",
-        );
-        for (k, name) in ["x_ref − x", "y_ref − y"].iter().enumerate() {
-            let e: Vec<f64> = r
-                .reference
-                .iter()
-                .zip(&run.ee)
-                .map(|(a, b)| a[k] - b[k])
-                .collect();
-            p.push(Series::line(name, &run.t, &e));
-        }
-        figs.save(&p, out, "xy_closed_loop_errors")?;
+        tracking_figures(
+            figs,
+            out,
+            &r.reference,
+            &r.runs,
+            run,
+            [
+                (
+                    "xy_closed_loop_path",
+                    "The grid model's closed loop on the off-centre circle",
+                ),
+                (
+                    "xy_closed_loop_errors",
+                    "Tracking errors of the grid model (from the gravity equilibrium)",
+                ),
+            ],
+        )?;
     }
     Ok(())
 }
