@@ -41,25 +41,43 @@ fn the_stored_curves_are_reproduced() {
     );
 }
 
-/// At its own grid points a grid model is the unreduced model's
-/// interpolation data: Q through the equilibria, V spanning the modes
-/// there, so ω3–ω8 agree to rounding (as the one-coordinate IBM-u at its
-/// references), and ω1, ω2 (Q,x and Q,y against the two mechanism modes)
-/// closely.
+/// At its own grid points a grid model's subspace [Q,x, Q,y, V] holds the
+/// unreduced eigenvectors 3–8 (V spans them there), so they are Ritz pairs
+/// of the reduced model: each unreduced ω3–ω8 is one of its eight
+/// frequencies to rounding. The other two approximate ω1, ω2 through Q,x
+/// and Q,y only, and as Ritz values they cannot lie below them
+/// (Courant–Fischer): measured, far above them on the coarse grids (ω3 at
+/// the grid points was "off by 84 %" when compared by rank, the inflated
+/// mechanism modes sorted above it).
 #[test]
-fn a_grid_model_is_exact_at_its_own_grid_points() {
+fn a_grid_model_holds_the_higher_modes_at_its_own_grid_points() {
     let r = study();
     let m = r.models.last().expect("a grid model");
     let z_of = |p: &flexmb_linearize::SweepPoint| xtask::ch7xy::z_at(&r.mech, r.dofs, p);
     let f = ch7::reduced_frequencies_at(&r.mech, &m.basis, &r.grid, &z_of, r.dofs, ch7::R)
         .unwrap_or_else(|e| panic!("{e}"));
-    for k in 2..ch7::R {
-        let e = errors(&r.grid, &f, k).into_iter().fold(0.0, f64::max);
-        assert!(e < 1e-6, "ω{} at the grid points: {e:.2e}", k + 1);
-    }
-    for k in 0..2 {
-        let e = errors(&r.grid, &f, k).into_iter().fold(0.0, f64::max);
-        assert!(e < 1e-2, "ω{} at the grid points: {e:.2e}", k + 1);
+    for (p, red) in r.grid.iter().zip(&f) {
+        for k in 2..ch7::R {
+            let w = p.frequencies_hz[k];
+            let e = red
+                .iter()
+                .map(|v| ((v - w) / w).abs())
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                e < 1e-6,
+                "ω{} = {w} Hz is not among {red:?}: {e:.2e}",
+                k + 1
+            );
+        }
+        for k in 0..2 {
+            assert!(
+                red[k] >= p.frequencies_hz[k] * (1.0 - 1e-9),
+                "the reduced ω{} {} below the unreduced {}",
+                k + 1,
+                red[k],
+                p.frequencies_hz[k]
+            );
+        }
     }
 }
 
