@@ -8,7 +8,7 @@
 use std::sync::OnceLock;
 use xtask::ch7;
 use xtask::progress::Progress;
-use xtask::reproduce7xy::{self, errors, XyResults};
+use xtask::reproduce7xy::{self, XyResults};
 
 fn study() -> &'static XyResults {
     static R: OnceLock<XyResults> = OnceLock::new();
