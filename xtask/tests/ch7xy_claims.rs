@@ -41,16 +41,16 @@ fn the_stored_curves_are_reproduced() {
     );
 }
 
-/// At its own grid points a grid model's subspace [Q,x, Q,y, V] holds the
-/// unreduced eigenvectors 3–8 (V spans them there), so they are Ritz pairs
-/// of the reduced model: each unreduced ω3–ω8 is one of its eight
-/// frequencies to the position solve's and the spline's rounding
-/// (measured: 1.7e-6 relative at a 5 × 5 grid point; chapter 7's IBM-u at
-/// its references: up to 3e-4, `ch7_claims.rs` allows 1e-3). The other two approximate ω1, ω2 through Q,x
-/// and Q,y only, and as Ritz values they cannot lie below them
-/// (Courant–Fischer): measured, far above them on the coarse grids (ω3 at
-/// the grid points was "off by 84 %" when compared by rank, the inflated
-/// mechanism modes sorted above it).
+/// At its own grid points a grid model's subspace [Q,x, Q,y, V] nearly
+/// holds the unreduced eigenvectors 3–8, so each unreduced ω3–ω8 is close
+/// to one of its eight frequencies (not exactly: V is columns 3–8 of the
+/// first eight modes orthonormalized by Gram–Schmidt, which carry parts of
+/// modes 1 and 2, as IBM-u's V_a (7.6); measured: up to 5.0e-4 relative on
+/// 5 × 5, where chapter 7's IBM-u at its references has up to 3e-4 and
+/// `ch7_claims.rs` allows 1e-3). The other two approximate ω1, ω2 through
+/// Q,x and Q,y only and, as Ritz values, cannot lie below them
+/// (Courant–Fischer): measured, 25 Hz against 0.8 Hz. Compared by rank,
+/// ω3 was "off by 84 %": the inflated mechanism modes sort above it.
 #[test]
 fn a_grid_model_holds_the_higher_modes_at_its_own_grid_points() {
     let r = study();
@@ -66,7 +66,7 @@ fn a_grid_model_holds_the_higher_modes_at_its_own_grid_points() {
                 .map(|v| ((v - w) / w).abs())
                 .fold(f64::INFINITY, f64::min);
             assert!(
-                e < 1e-4,
+                e < 1e-3,
                 "ω{} = {w} Hz is not among {red:?}: {e:.2e}",
                 k + 1
             );
