@@ -13,8 +13,8 @@ use flexmb_dynamics::Dynamics;
 use flexmb_linearize::SweepPoint;
 use flexmb_model::{ControllerSpec, Mechanism, Scene, Select, TimeFunction};
 use flexmb_reduction::{
-    constrained_eigenvectors, unconstrained_path_eigenvectors, CubicSpline, InterpolatedBasis,
-    ReducedModel, SubspaceInterpolation,
+    constrained_eigenvectors, unconstrained_path_eigenvectors, Basis, CubicSpline,
+    InterpolatedBasis, ReducedModel, SubspaceInterpolation,
 };
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -183,7 +183,10 @@ pub fn basis(
 }
 
 /// The reduced model of `basis` on `mech` (its DOFs are the basis's).
-pub fn reduced(mech: &Arc<Mechanism>, basis: &InterpolatedBasis) -> Result<ReducedModel, String> {
+pub fn reduced<B: Basis + Clone + 'static>(
+    mech: &Arc<Mechanism>,
+    basis: &B,
+) -> Result<ReducedModel, String> {
     ReducedModel::new(mech.clone(), Box::new(basis.clone())).map_err(|e| e.to_string())
 }
 
@@ -202,6 +205,25 @@ pub fn reduced_frequencies(
     dofs: [usize; 2],
     count: usize,
 ) -> Result<Vec<Vec<f64>>, String> {
+    let n_z = 1 + basis.r();
+    let z_of = |p: &SweepPoint| {
+        let mut z = vec![0.0; n_z];
+        z[0] = p.s;
+        z
+    };
+    reduced_frequencies_at(mech, basis, points, &z_of, dofs, count)
+}
+
+/// [`reduced_frequencies`] of any basis, each equilibrium `p` at the
+/// reduced coordinates `z_of(p)` (the grid model: its held x and y).
+pub fn reduced_frequencies_at<B: Basis + Clone + Sync + 'static>(
+    mech: &Arc<Mechanism>,
+    basis: &B,
+    points: &[SweepPoint],
+    z_of: &(dyn Fn(&SweepPoint) -> Vec<f64> + Sync),
+    dofs: [usize; 2],
+    count: usize,
+) -> Result<Vec<Vec<f64>>, String> {
     let chunk = points
         .len()
         .div_ceil(rayon::current_num_threads().max(1))
@@ -215,14 +237,13 @@ pub fn reduced_frequencies(
             block
                 .iter()
                 .map(|p| {
-                    let mut z = vec![0.0; basis_n_z(basis)];
-                    z[0] = p.s;
+                    let z = z_of(p);
                     m.dynamics_mut().kinematics_mut().set_guess(&p.x);
                     load[dofs[0]] = p.holding[0];
                     load[dofs[1]] = p.holding[1];
                     let (mz, kz) = m
                         .linearize_at_rest_loaded(0.0, &z, Some(&load))
-                        .map_err(|e| format!("the reduced model at s = {}: {e}", p.s))?;
+                        .map_err(|e| format!("the reduced model at z = {z:?}: {e}"))?;
                     let mut f = flexmb_linearize::generalized_symmetric(&kz, &mz, mz.nrows())
                         .map_err(|e| e.to_string())?
                         .frequencies_hz();
@@ -239,16 +260,17 @@ pub fn reduced_frequencies(
     Ok(out)
 }
 
-fn basis_n_z(b: &InterpolatedBasis) -> usize {
-    1 + b.r()
-}
-
 /// The reference motion s(t) of §7.2.3: five skew-sine moves (7.13) of
 /// T = 0.25 s from stop to stop, each followed by 0.05 s at rest, to the
 /// marks s1–s5 of the path (the start of the circle and every quarter turn;
 /// Fig. 7.1 with the thesis's stops is lost), over 1.5 s.
 pub fn reference_motion() -> TimeFunction {
-    let marks = Path4::new().marks();
+    skew_sine_moves(&Path4::new().marks())
+}
+
+/// Skew-sine moves (7.13) from s = 0 to each of `marks` in turn, each of
+/// T = [`MOVE_TIME`] followed by [`DWELL`] at rest (§7.2.3's timing).
+pub fn skew_sine_moves(marks: &[f64]) -> TimeFunction {
     let mut prev = 0.0;
     let moves = marks
         .iter()
@@ -272,6 +294,32 @@ pub fn angle_references(
     model: &mut ReducedModel,
     samples: usize,
 ) -> Result<[TimeFunction; 2], String> {
+    let n_z = model.n_z();
+    let z_of = |s: f64| {
+        let mut z = vec![0.0; n_z];
+        z[0] = s;
+        z
+    };
+    angle_references_along(
+        model,
+        samples,
+        Path4::new().length(),
+        &reference_motion(),
+        &z_of,
+    )
+}
+
+/// [`angle_references`] along any path of arc length `length` that the
+/// reduced model describes with η ≡ 0 by z = `z_of(s)` (the one-coordinate
+/// models: z = (s, 0); the grid model: z = (x(s), y(s), 0)), followed with
+/// the arc length `motion` s(t).
+pub fn angle_references_along(
+    model: &mut ReducedModel,
+    samples: usize,
+    length: f64,
+    motion: &TimeFunction,
+    z_of: &dyn Fn(f64) -> Vec<f64>,
+) -> Result<[TimeFunction; 2], String> {
     let mech = model.dynamics().mechanism().clone();
     let eps_index = |hinge: &str| {
         let name = format!("{hinge}.rotation");
@@ -281,16 +329,13 @@ pub fn angle_references(
             .ok_or_else(|| format!("no deformation {name}"))
     };
     let idx = [eps_index(ACTUATORS[0].0)?, eps_index(ACTUATORS[1].0)?];
-    let l = Path4::new().length();
+    let l = length;
     let s: Vec<f64> = (0..samples)
         .map(|i| l * i as f64 / (samples - 1) as f64)
         .collect();
-    let n_z = model.n_z();
     let mut values = vec![];
     for si in &s {
-        let mut z = vec![0.0; n_z];
-        z[0] = *si;
-        let q = model.full_coordinates(&z);
+        let q = model.full_coordinates(&z_of(*si));
         let dy = model.dynamics_mut();
         dy.kinematics_mut()
             .solve(&q, 0.0)
@@ -299,7 +344,6 @@ pub fn angle_references(
         values.push(vec![eps[idx[0]], eps[idx[1]]]);
     }
     let spline = CubicSpline::new(s, values).map_err(|e| e.to_string())?;
-    let motion = reference_motion();
     let pieces = (T_END * 1000.0).round() as usize;
     let breaks: Vec<f64> = (0..=pieces)
         .map(|i| T_END * i as f64 / pieces as f64)

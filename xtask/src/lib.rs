@@ -11,6 +11,7 @@ pub mod ch4;
 pub mod ch5;
 pub mod ch6;
 pub mod ch7;
+pub mod ch7xy;
 pub mod curves;
 pub mod fuzz;
 pub mod models;
@@ -23,6 +24,7 @@ pub mod reproduce3;
 pub mod reproduce4;
 pub mod reproduce6;
 pub mod reproduce7;
+pub mod reproduce7xy;
 pub mod solid6;
 
 /// The workspace root (the parent of this crate).

@@ -1,4 +1,4 @@
-//! `cargo xtask reproduce ch2|ch3|ch4|ch5|ch6|ch7|all`, `cargo xtask regress` and `cargo xtask fuzz`.
+//! `cargo xtask reproduce ch2|ch3|ch4|ch5|ch6|ch7|ch7xy|all`, `cargo xtask regress` and `cargo xtask fuzz`.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -24,6 +24,8 @@ enum Chapter {
     Ch5,
     Ch6,
     Ch7,
+    /// Beyond the thesis: the two-coordinate basis over the workspace.
+    Ch7xy,
     All,
 }
 
@@ -41,7 +43,7 @@ enum FuzzTarget {
 enum Cmd {
     /// Regenerate a chapter's results into OUT/chN (CSV, SVG, report.md).
     Reproduce {
-        /// ch2, ch3, ch4, ch5, ch6, ch7 or all.
+        /// ch2, ch3, ch4, ch5, ch6, ch7, ch7xy or all.
         chapter: Chapter,
         /// Output directory.
         #[arg(long, default_value = "results")]
@@ -68,7 +70,7 @@ enum Cmd {
         /// Store the recomputed curves as the new fixtures instead of comparing.
         #[arg(long)]
         update: bool,
-        /// Only this chapter's curves (ch2, ch3, ch4, ch5, ch6 or ch7; default all).
+        /// Only this chapter's curves (ch2, ch3, ch4, ch5, ch6, ch7 or ch7xy; default all).
         #[arg(long, value_enum)]
         chapter: Option<Chapter>,
     },
@@ -259,6 +261,15 @@ fn reproduce(
             out.join("ch7/report.md").display()
         ));
     }
+    if matches!(ch, Chapter::Ch7xy | Chapter::All) {
+        let t = std::time::Instant::now();
+        xtask::reproduce7xy::reproduce(root, &out.join("ch7xy"), pg)?;
+        summary.push(format!(
+            "chapter 7, two coordinates, in {:.0} s: {}",
+            t.elapsed().as_secs_f64(),
+            out.join("ch7xy/report.md").display()
+        ));
+    }
     for l in summary {
         println!("{l}");
     }
@@ -272,13 +283,14 @@ fn regress(
     pg: &Progress,
 ) -> Result<(), String> {
     type Recompute = fn(&std::path::Path, &Progress) -> Result<xtask::regress::Recomputed, String>;
-    let chapters: [(Chapter, Recompute); 6] = [
+    let chapters: [(Chapter, Recompute); 7] = [
         (Chapter::Ch2, xtask::regress::recompute_ch2),
         (Chapter::Ch3, xtask::ch3::recompute),
         (Chapter::Ch4, xtask::reproduce4::recompute),
         (Chapter::Ch5, xtask::regress::recompute_ch5),
         (Chapter::Ch6, xtask::regress::recompute_ch6),
         (Chapter::Ch7, xtask::reproduce7::recompute),
+        (Chapter::Ch7xy, xtask::reproduce7xy::recompute),
     ];
     let sets = chapters
         .iter()

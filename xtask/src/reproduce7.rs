@@ -280,52 +280,14 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
         .iter()
         .map(|t| [refs[0].value(*t), refs[1].value(*t)])
         .collect();
-    let reference = s_of_t
-        .iter()
-        .map(|s| {
-            let mut z = vec![0.0; kin_model.n_z()];
-            z[0] = *s;
-            let q = kin_model.full_coordinates(&z);
-            let dy = kin_model.dynamics_mut();
-            dy.kinematics_mut()
-                .solve(&q, 0.0)
-                .map_err(|e| e.to_string())?;
-            Ok(ch7::end_effector(&mech, dy.kinematics().x()))
-        })
-        .collect::<Result<Vec<_>, String>>()?;
-    let mut runs = vec![];
-    let adams = |rtol: f64| {
-        let mut o = SimulationOptions::new(Integrator::Adams, 0.0, ch7::T_END, ch7::OUTPUTS);
-        o.rtol = rtol;
-        o.atol = rtol * 1e-3;
-        o
+    let n_z = kin_model.n_z();
+    let z_of = |s: f64| {
+        let mut z = vec![0.0; n_z];
+        z[0] = s;
+        z
     };
-    for (label, from_equilibrium) in [
-        ("IBM-u from the undeflected configuration", false),
-        ("IBM-u from the gravity equilibrium", true),
-    ] {
-        let mut model = ch7::reduced(&cmech, ibm_u)?;
-        let mut z = z0.clone();
-        if from_equilibrium {
-            let eq = MechanicalModel::static_equilibrium(
-                &mut model,
-                0.0,
-                &z,
-                &flexmb_dynamics::StaticOptions::default(),
-            )
-            .map_err(|e| format!("the gravity equilibrium of IBM-u: {e}"))?;
-            z = eq.coordinates;
-        }
-        let bar = pg.bar(label, 1000);
-        let tr =
-            MechanicalModel::simulate(&mut model, 0.0, &z, &z0, &adams(1e-3), &mut |t, _, _| {
-                bar.set((t / ch7::T_END * 1000.0) as u64);
-                Control::Continue
-            })
-            .map_err(|e| format!("{label}: {e}"))?;
-        bar.finish();
-        runs.push(run_of(label, &cmech, &tr.full));
-    }
+    let reference = reference_end_effector(&mut kin_model, &s_of_t, &z_of)?;
+    let mut runs = closed_loop_pair(&cmech, ibm_u, "IBM-u", pg)?;
     // 6. the unreduced closed loop, generalized-α, within its budget
     let stop = Arc::new(AtomicBool::new(false));
     let timer = {
@@ -371,6 +333,63 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
         angles,
         s_of_t,
     })
+}
+
+/// The end-effector (x, y, z) of the reduced model `kin` (no gravity) with
+/// η ≡ 0 at the arc lengths `s`, at z = `z_of(s)`: the reference path the
+/// controllers' angle references describe.
+pub fn reference_end_effector(
+    kin: &mut flexmb_reduction::ReducedModel,
+    s: &[f64],
+    z_of: &dyn Fn(f64) -> Vec<f64>,
+) -> Result<Vec<[f64; 3]>, String> {
+    s.iter()
+        .map(|s| {
+            let q = kin.full_coordinates(&z_of(*s));
+            let dy = kin.dynamics_mut();
+            dy.kinematics_mut()
+                .solve(&q, 0.0)
+                .map_err(|e| e.to_string())?;
+            Ok(ch7::end_effector(dy.mechanism(), dy.kinematics().x()))
+        })
+        .collect()
+}
+
+/// The closed loop of a reduced `model` (of the mechanism with gravity and
+/// the PD controllers) over [`ch7::T_END`] with [`ch7::OUTPUTS`] outputs,
+/// Adams (rtol 1e-3, atol 1e-6), from `z0` at rest, or from the gravity
+/// equilibrium next to it if `from_equilibrium`, with a progress bar.
+pub fn reduced_closed_loop(
+    model: &mut flexmb_reduction::ReducedModel,
+    z0: &[f64],
+    from_equilibrium: bool,
+    label: &str,
+    pg: &Progress,
+) -> Result<Run, String> {
+    let mut z = z0.to_vec();
+    if from_equilibrium {
+        let eq = MechanicalModel::static_equilibrium(
+            model,
+            0.0,
+            &z,
+            &flexmb_dynamics::StaticOptions::default(),
+        )
+        .map_err(|e| format!("the gravity equilibrium of {label}: {e}"))?;
+        z = eq.coordinates;
+    }
+    let mut o = SimulationOptions::new(Integrator::Adams, 0.0, ch7::T_END, ch7::OUTPUTS);
+    o.rtol = 1e-3;
+    o.atol = 1e-6;
+    let bar = pg.bar(label, 1000);
+    let rest = vec![0.0; z.len()];
+    let tr = MechanicalModel::simulate(model, 0.0, &z, &rest, &o, &mut |t, _, _| {
+        bar.set((t / ch7::T_END * 1000.0) as u64);
+        Control::Continue
+    })
+    .map_err(|e| format!("{label}: {e}"))?;
+    bar.finish();
+    let mech = model.dynamics().mechanism().clone();
+    Ok(run_of(label, &mech, &tr.full))
 }
 
 /// Writes the report of chapter 7 into `out`.
@@ -502,31 +521,20 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
         p.push(Series::line(name, &t, &a));
     }
     figs.save(&p, out, "fig7_4_reference")?;
-    let mut p =
-        Plot::new("Fig. 7.5a: the end-effector in the plane", "x (m)", "y (m)").equal_aspect();
-    let xy = |e: &[[f64; 3]]| -> (Vec<f64>, Vec<f64>) { e.iter().map(|p| (p[0], p[1])).unzip() };
-    let (x, y) = xy(&r.reference);
-    p.push(Series::line("reference", &x, &y));
-    for run in &r.runs[..2] {
-        let (x, y) = xy(&run.ee);
-        p.push(Series::dashed(&run.label, &x, &y));
-    }
-    figs.save(&p, out, "fig7_5a_path")?;
-    let mut p = Plot::new(
-        "Fig. 7.5b: tracking errors of IBM-u (from the gravity equilibrium)",
-        "t (s)",
-        "error (m)",
-    );
-    for (k, name) in ["x_ref − x", "y_ref − y"].iter().enumerate() {
-        let e: Vec<f64> = r
-            .reference
-            .iter()
-            .zip(&r.runs[1].ee)
-            .map(|(a, b)| a[k] - b[k])
-            .collect();
-        p.push(Series::line(name, &t, &e));
-    }
-    figs.save(&p, out, "fig7_5b_errors")?;
+    tracking_figures(
+        figs,
+        out,
+        &r.reference,
+        &r.runs[..2],
+        &r.runs[1],
+        [
+            ("fig7_5a_path", "Fig. 7.5a: the end-effector in the plane"),
+            (
+                "fig7_5b_errors",
+                "Fig. 7.5b: tracking errors of IBM-u (from the gravity equilibrium)",
+            ),
+        ],
+    )?;
     let mut p = Plot::new("Fig. 7.6: z of the end-effector", "t (s)", "z (m)");
     for run in &r.runs {
         let z: Vec<f64> = run.ee.iter().map(|p| p[2]).collect();
@@ -547,6 +555,66 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
     ));
     figs.save(&p, out, "fig7_7_spectrum")?;
     Ok(())
+}
+
+/// Two figures of closed-loop `runs` against the `reference` end-effector
+/// path: the paths in the plane, and the x, y tracking errors of `tracked`
+/// over time; `names` are (file stem, title) of each.
+pub fn tracking_figures(
+    figs: &mut Figures,
+    out: &Path,
+    reference: &[[f64; 3]],
+    runs: &[Run],
+    tracked: &Run,
+    names: [(&str, &str); 2],
+) -> std::io::Result<()> {
+    let mut p = Plot::new(names[0].1, "x (m)", "y (m)").equal_aspect();
+    let xy = |e: &[[f64; 3]]| -> (Vec<f64>, Vec<f64>) { e.iter().map(|p| (p[0], p[1])).unzip() };
+    let (x, y) = xy(reference);
+    p.push(Series::line("reference", &x, &y));
+    for run in runs {
+        let (x, y) = xy(&run.ee);
+        p.push(Series::dashed(&run.label, &x, &y));
+    }
+    figs.save(&p, out, names[0].0)?;
+    let mut p = Plot::new(names[1].1, "t (s)", "error (m)");
+    for (k, name) in ["x_ref − x", "y_ref − y"].iter().enumerate() {
+        let e: Vec<f64> = reference
+            .iter()
+            .zip(&tracked.ee)
+            .map(|(a, b)| a[k] - b[k])
+            .collect();
+        p.push(Series::line(name, &tracked.t, &e));
+    }
+    figs.save(&p, out, names[1].0)
+}
+
+/// The closed loops of a reduced model of `cmech` (gravity, controllers)
+/// with `basis` from z = 0 at rest and from the gravity equilibrium next to
+/// it ([`reduced_closed_loop`]), labelled "`name` from …".
+pub fn closed_loop_pair<B: flexmb_reduction::Basis + Clone + 'static>(
+    cmech: &Arc<flexmb_model::Mechanism>,
+    basis: &B,
+    name: &str,
+    pg: &Progress,
+) -> Result<Vec<Run>, String> {
+    let z0 = vec![0.0; basis.n_z()];
+    [
+        ("the undeflected configuration", false),
+        ("the gravity equilibrium", true),
+    ]
+    .into_iter()
+    .map(|(from, from_equilibrium)| {
+        let mut model = ch7::reduced(cmech, basis)?;
+        reduced_closed_loop(
+            &mut model,
+            &z0,
+            from_equilibrium,
+            &format!("{name} from {from}"),
+            pg,
+        )
+    })
+    .collect()
 }
 
 /// The spectrum of z_eq − z_undef over the 1000 steps of the IBM-u runs.

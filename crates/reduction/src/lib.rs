@@ -12,7 +12,9 @@
 //! fixed basis method G = q0 + Vη (6.16) with modal (5.21) and SVD-modal
 //! (5.22)–(5.23) bases, and the interpolated basis method (6.23) with cubic
 //! splines and modal subspace interpolation (§6.3.3) or MAC-sorted
-//! eigenvectors, the per-mode SVD (6.19)–(6.21), the path eigenvectors of
+//! eigenvectors, its extension to two configuration coordinates on a
+//! tensor grid ([`GridBasis`]: bicubic splines, MSI over the grid; beyond
+//! the thesis), the per-mode SVD (6.19)–(6.21), the path eigenvectors of
 //! chapter 7 (7.3)–(7.11), reduced statics with load-scale continuation
 //! ([`load_scale_path`]), the reduced linearization (F.5) with its rest form
 //! (F.7), and saving and loading reduced models ([`SavedModel`]).
@@ -37,7 +39,9 @@
 #![warn(missing_docs)]
 
 mod basis;
+mod bicubic;
 mod continuation;
+mod grid;
 mod ibm;
 mod mechanical;
 mod model;
@@ -50,11 +54,16 @@ pub use basis::{
     fixed_basis_frequencies, modal_basis, per_mode_svd_basis, svd_modal_basis, Basis, FixedBasis,
     PerModeSvd, SvdModal, FINAL_SVD_THRESHOLD, SVD_THRESHOLD,
 };
+pub use bicubic::{order_index, BicubicSpline, ORDERS};
 pub use continuation::{continue_load_scale, load_scale_path, SUBSTEPS};
+pub use grid::{GridBasis, GridKnots};
 pub use ibm::{interpolated_basis_from_sweep, InterpolatedBasis, Knots, SubspaceInterpolation};
 pub use mechanical::{Equilibrium, MechanicalModel, ModelTrajectory, StateObserver, SweepPoint};
 pub use model::{ReducedLinearization, ReducedModel, ReducedTrajectory};
-pub use msi::{largest_principal_angle, mac_sorted, modal_subspace_interpolation, orthonormalize};
+pub use msi::{
+    largest_principal_angle, mac_sorted, modal_subspace_interpolation,
+    modal_subspace_interpolation_grid, orthonormalize,
+};
 pub use path::{
     constrained_eigenvectors, null_space_of_transpose, unconstrained_path_eigenvectors,
 };

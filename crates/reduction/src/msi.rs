@@ -37,28 +37,79 @@ pub fn modal_subspace_interpolation(v: &[Mat<f64>], mass: Option<&[Mat<f64>]>) -
     }
     w.push(vs[0].clone());
     for i in 0..vs.len() - 1 {
-        let vn = &vs[i + 1];
-        let proj = vn * (vn.transpose() * &w[i]);
-        let (n, r) = (proj.nrows(), proj.ncols());
-        let mut next = proj;
-        for j in 0..r {
-            let nrm = (0..n).map(|k| next[(k, j)].powi(2)).sum::<f64>().sqrt();
-            for k in 0..n {
-                next[(k, j)] /= nrm;
-            }
-        }
-        w.push(next);
+        w.push(msi_step(&vs[i + 1], &w[i]));
     }
     if let Some(m) = mass {
         for (wi, mi) in w.iter_mut().zip(m) {
-            let mw = mi * &*wi;
-            for j in 0..wi.ncols() {
-                let s: f64 = (0..wi.nrows()).map(|k| wi[(k, j)] * mw[(k, j)]).sum();
-                let f = 1.0 / s.sqrt();
-                for k in 0..wi.nrows() {
-                    wi[(k, j)] *= f;
-                }
-            }
+            mass_normalize(wi, mi);
+        }
+    }
+    w
+}
+
+/// Steps 3–6 of MSI: the base vectors at the next configuration, whose
+/// orthonormal eigenvectors are `vn`, from those `w` at the previous one:
+/// the columns of vn vnᵀ w, each normalized to unit length.
+pub(crate) fn msi_step(vn: &Mat<f64>, w: &Mat<f64>) -> Mat<f64> {
+    let mut next = vn * (vn.transpose() * w);
+    let (n, r) = (next.nrows(), next.ncols());
+    for j in 0..r {
+        let nrm = (0..n).map(|k| next[(k, j)].powi(2)).sum::<f64>().sqrt();
+        for k in 0..n {
+            next[(k, j)] /= nrm;
+        }
+    }
+    next
+}
+
+/// Step 7 of MSI, (6.26): each column w scaled to w/√(wᵀMw).
+pub(crate) fn mass_normalize(w: &mut Mat<f64>, m: &Mat<f64>) {
+    let mw = m * &*w;
+    for j in 0..w.ncols() {
+        let s: f64 = (0..w.nrows()).map(|k| w[(k, j)] * mw[(k, j)]).sum();
+        let f = 1.0 / s.sqrt();
+        for k in 0..w.nrows() {
+            w[(k, j)] *= f;
+        }
+    }
+}
+
+/// MSI over a tensor grid of configurations (two configuration coordinates,
+/// [`crate::GridBasis`]): `v` holds the eigenvectors at the n1 × n2 grid
+/// points, point (i, j) at index i + n1 j (the first coordinate fastest).
+/// Steps 1–6 run along the first row (j = 0) from its first point, then
+/// along every column (i fixed) from that row, so each point's base vectors
+/// are projected from a neighbour's, as in the one-parameter MSI; step 7
+/// mass-normalizes with `mass` when given. With one column of data repeated
+/// over the rows, every row gets the one-parameter MSI's vectors.
+pub fn modal_subspace_interpolation_grid(
+    v: &[Mat<f64>],
+    n1: usize,
+    n2: usize,
+    mass: Option<&[Mat<f64>]>,
+) -> Vec<Mat<f64>> {
+    if v.len() != n1 * n2 || v.is_empty() {
+        return vec![];
+    }
+    let vs: Vec<Mat<f64>> = v.iter().map(orthonormalize).collect();
+    let mut w: Vec<Option<Mat<f64>>> = vec![None; vs.len()];
+    w[0] = Some(vs[0].clone());
+    for i in 1..n1 {
+        let prev = w[i - 1].as_ref().map(|p| msi_step(&vs[i], p));
+        w[i] = prev;
+    }
+    for j in 1..n2 {
+        for i in 0..n1 {
+            let prev = w[i + n1 * (j - 1)]
+                .as_ref()
+                .map(|p| msi_step(&vs[i + n1 * j], p));
+            w[i + n1 * j] = prev;
+        }
+    }
+    let mut w: Vec<Mat<f64>> = w.into_iter().flatten().collect();
+    if let Some(m) = mass {
+        for (wi, mi) in w.iter_mut().zip(m) {
+            mass_normalize(wi, mi);
         }
     }
     w

@@ -22,57 +22,14 @@ impl CubicSpline {
                 y.len()
             )));
         }
-        if s.windows(2).any(|w| w[1] <= w[0]) || s.iter().any(|v| !v.is_finite()) {
-            return Err(ReductionError::Invalid(
-                "spline knots must be finite and strictly increasing".into(),
-            ));
-        }
+        check_knots(&s, "spline")?;
         let d = y[0].len();
         if y.iter().any(|v| v.len() != d) {
             return Err(ReductionError::Invalid(
                 "spline values of different lengths".into(),
             ));
         }
-        // tridiagonal system for the interior second derivatives (natural ends)
-        let mut m = vec![vec![0.0; d]; n];
-        if n > 2 {
-            let k = n - 2;
-            let h: Vec<f64> = s.windows(2).map(|w| w[1] - w[0]).collect();
-            let mut diag = vec![0.0; k];
-            let mut off = vec![0.0; k];
-            for i in 0..k {
-                diag[i] = 2.0 * (h[i] + h[i + 1]);
-                off[i] = h[i + 1];
-            }
-            // Thomas algorithm, one right-hand side per component
-            let mut cp = vec![0.0; k];
-            let mut dp = vec![0.0; k];
-            cp[0] = off[0] / diag[0];
-            dp[0] = diag[0];
-            for i in 1..k {
-                dp[i] = diag[i] - h[i] * cp[i - 1];
-                cp[i] = off[i] / dp[i];
-            }
-            for c in 0..d {
-                let rhs: Vec<f64> = (0..k)
-                    .map(|i| {
-                        6.0 * ((y[i + 2][c] - y[i + 1][c]) / h[i + 1]
-                            - (y[i + 1][c] - y[i][c]) / h[i])
-                    })
-                    .collect();
-                let mut z = vec![0.0; k];
-                z[0] = rhs[0] / dp[0];
-                for i in 1..k {
-                    z[i] = (rhs[i] - h[i] * z[i - 1]) / dp[i];
-                }
-                for i in (0..k - 1).rev() {
-                    z[i] -= cp[i] * z[i + 1];
-                }
-                for i in 0..k {
-                    m[i + 1][c] = z[i];
-                }
-            }
-        }
+        let m = natural_second_derivatives(&s, &y);
         Ok(Self { s, y, m })
     }
 
@@ -84,24 +41,12 @@ impl CubicSpline {
     /// Value and the first three derivatives at s (outside the knots the end
     /// cubic is extended), written into `out[0..4]` (each of length d).
     pub fn eval(&self, s: f64, out: &mut [Vec<f64>; 4]) {
-        let n = self.s.len();
-        let i = match self.s.partition_point(|v| *v <= s) {
-            0 => 0,
-            p if p >= n => n - 2,
-            p => p - 1,
-        };
-        let h = self.s[i + 1] - self.s[i];
-        let a = (self.s[i + 1] - s) / h;
-        let b = (s - self.s[i]) / h;
+        let (i, w) = interval_weights(&self.s, s);
         let (y0, y1, m0, m1) = (&self.y[i], &self.y[i + 1], &self.m[i], &self.m[i + 1]);
-        for c in 0..y0.len() {
-            out[0][c] = a * y0[c]
-                + b * y1[c]
-                + ((a * a * a - a) * m0[c] + (b * b * b - b) * m1[c]) * h * h / 6.0;
-            out[1][c] = (y1[c] - y0[c]) / h
-                + ((3.0 * b * b - 1.0) * m1[c] - (3.0 * a * a - 1.0) * m0[c]) * h / 6.0;
-            out[2][c] = a * m0[c] + b * m1[c];
-            out[3][c] = (m1[c] - m0[c]) / h;
+        for (o, w) in w.iter().enumerate() {
+            for c in 0..y0.len() {
+                out[o][c] = w[0] * y0[c] + w[1] * y1[c] + w[2] * m0[c] + w[3] * m1[c];
+            }
         }
     }
 
@@ -110,6 +55,95 @@ impl CubicSpline {
         let d = self.y[0].len();
         [vec![0.0; d], vec![0.0; d], vec![0.0; d], vec![0.0; d]]
     }
+}
+
+/// An error naming `what` unless the knots are finite and strictly increasing.
+pub(crate) fn check_knots(s: &[f64], what: &str) -> Result<(), ReductionError> {
+    if s.windows(2).any(|w| w[1] <= w[0]) || s.iter().any(|v| !v.is_finite()) {
+        return Err(ReductionError::Invalid(format!(
+            "{what} knots must be finite and strictly increasing"
+        )));
+    }
+    Ok(())
+}
+
+/// The second derivatives at the knots `s` of the natural cubic spline
+/// through the values `y` (one vector per knot, all of one length; the knots
+/// already checked: at least 2, strictly increasing): the tridiagonal system
+/// of the interior knots with zero curvature at both ends, solved by the
+/// Thomas algorithm for each component.
+pub(crate) fn natural_second_derivatives(s: &[f64], y: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let n = s.len();
+    let d = y.first().map_or(0, |v| v.len());
+    let mut m = vec![vec![0.0; d]; n];
+    if n <= 2 {
+        return m;
+    }
+    let k = n - 2;
+    let h: Vec<f64> = s.windows(2).map(|w| w[1] - w[0]).collect();
+    let mut cp = vec![0.0; k];
+    let mut dp = vec![0.0; k];
+    cp[0] = h[1] / (2.0 * (h[0] + h[1]));
+    dp[0] = 2.0 * (h[0] + h[1]);
+    for i in 1..k {
+        dp[i] = 2.0 * (h[i] + h[i + 1]) - h[i] * cp[i - 1];
+        cp[i] = h[i + 1] / dp[i];
+    }
+    let mut z = vec![0.0; k];
+    for c in 0..d {
+        let rhs = |i: usize| {
+            6.0 * ((y[i + 2][c] - y[i + 1][c]) / h[i + 1] - (y[i + 1][c] - y[i][c]) / h[i])
+        };
+        z[0] = rhs(0) / dp[0];
+        for i in 1..k {
+            z[i] = (rhs(i) - h[i] * z[i - 1]) / dp[i];
+        }
+        for i in (0..k - 1).rev() {
+            z[i] -= cp[i] * z[i + 1];
+        }
+        for i in 0..k {
+            m[i + 1][c] = z[i];
+        }
+    }
+    m
+}
+
+/// The interval i of the knots `s` that holds `x` (the end intervals
+/// extended beyond the knots) and the weights of a cubic spline's value and
+/// first three derivatives there: derivative o at x is
+/// w[o][0] y_i + w[o][1] y_(i+1) + w[o][2] m_i + w[o][3] m_(i+1), with y the
+/// values and m the second derivatives at the knots. A spline is linear in
+/// its data, so the same weights serve every component and the tensor
+/// product of two of them (the bicubic spline of [`crate::GridBasis`]).
+pub(crate) fn interval_weights(s: &[f64], x: f64) -> (usize, [[f64; 4]; 4]) {
+    let n = s.len();
+    let i = match s.partition_point(|v| *v <= x) {
+        0 => 0,
+        p if p >= n => n - 2,
+        p => p - 1,
+    };
+    let h = s[i + 1] - s[i];
+    let a = (s[i + 1] - x) / h;
+    let b = (x - s[i]) / h;
+    (
+        i,
+        [
+            [
+                a,
+                b,
+                (a * a * a - a) * h * h / 6.0,
+                (b * b * b - b) * h * h / 6.0,
+            ],
+            [
+                -1.0 / h,
+                1.0 / h,
+                -(3.0 * a * a - 1.0) * h / 6.0,
+                (3.0 * b * b - 1.0) * h / 6.0,
+            ],
+            [0.0, 0.0, a, b],
+            [0.0, 0.0, -1.0 / h, 1.0 / h],
+        ],
+    )
 }
 
 #[cfg(test)]
