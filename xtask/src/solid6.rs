@@ -333,7 +333,7 @@ pub fn section(
         "model",
         "DOF",
         "sweep (s)",
-        "largest |error| f1",
+        "largest \\|error\\| f1",
         "f2",
         "f3",
         "f4",
@@ -352,7 +352,7 @@ pub fn section(
     let _ = writeln!(s, "{}", t.render());
     if let Some(ph) = physical {
         let _ = writeln!(s, "Against the physical solid ({}), the same models: the {ANTICLASTIC} add the sheets' anticlastic curl (docs/elements.md, research/sheet22/README.md \"The Poisson share\"), the Poisson share that beam theory lacks; with ν = 0 it decouples, so they are meant for this solid, the other models for the one above.\n", ph.label);
-        let mut t = Table::new(&["model", "largest |error| f1", "f2", "f3", "f4"]);
+        let mut t = Table::new(&["model", "largest \\|error\\| f1", "f2", "f3", "f4"]);
         for m in models {
             let worst = worst_errors(ph, &model_x, &m.freqs);
             let mut row = vec![m.name.clone()];
