@@ -60,6 +60,25 @@ pub fn check(r: &Recomputed) -> Vec<String> {
     out
 }
 
+/// The curves stored in `dir` are `curves` within [`RTOL`]: `Ok`, or every
+/// difference, one per line, for a claims test to fail with.
+pub fn reproduced(dir: std::path::PathBuf, curves: Vec<StoredCurve>) -> Result<(), String> {
+    let d = check(&Recomputed {
+        dir,
+        curves,
+        provenance: vec![],
+    });
+    if d.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{} differences (tolerance {RTOL:e}):\n{}",
+            d.len(),
+            d.join("\n")
+        ))
+    }
+}
+
 /// Stores recomputed curves as the new fixtures.
 pub fn update(r: &Recomputed) -> Result<(), String> {
     for c in &r.curves {

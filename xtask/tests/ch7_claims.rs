@@ -35,21 +35,10 @@ fn worst(v: usize, k: usize) -> f64 {
 
 #[test]
 fn the_stored_curves_are_reproduced() {
-    let f = frequencies();
-    let r = xtask::regress::Recomputed {
-        dir: reproduce7::curve_dir(&xtask::workspace_root()),
-        curves: reproduce7::stored_curves(f),
-        provenance: vec![],
-    };
-    assert_eq!(r.curves.len(), 3, "unreduced, IBM-u and IBM-c");
-    let d = xtask::regress::check(&r);
-    assert!(
-        d.is_empty(),
-        "{} differences (tolerance {:e}):\n{}",
-        d.len(),
-        xtask::regress::RTOL,
-        d.join("\n")
-    );
+    let curves = reproduce7::stored_curves(frequencies());
+    assert_eq!(curves.len(), 3, "unreduced, IBM-u and IBM-c");
+    let dir = reproduce7::curve_dir(&xtask::workspace_root());
+    xtask::regress::reproduced(dir, curves).unwrap_or_else(|e| panic!("{e}"));
 }
 
 /// "IBM-u matches all eight": ω3–ω8 at every reference configuration
