@@ -261,10 +261,42 @@ pub fn grid_vectors(p: &SweepPoint) -> Result<Mat<f64>, String> {
     Ok(o.subcols(2, ch7::R - 2).to_owned())
 }
 
+/// The equilibrium surface's tangents ∂q/∂x and ∂q/∂y at each of `points`
+/// (held equilibria of the end-effector's DOFs `dofs`): the static modes of
+/// the held DOFs from the tangent stiffness there
+/// ([`flexmb_reduction::equilibrium_tangents`]), in parallel.
+pub fn grid_tangents(
+    mech: &Arc<Mechanism>,
+    dofs: [usize; 2],
+    points: &[SweepPoint],
+) -> Result<Vec<[Vec<f64>; 2]>, String> {
+    points
+        .par_iter()
+        .map_init(
+            || Dynamics::new(mech.clone()),
+            |dy, p| {
+                dy.kinematics_mut().set_guess(&p.x);
+                let lin = dy.linearize_at_rest(0.0, &p.q).map_err(|e| e.to_string())?;
+                let t =
+                    flexmb_reduction::equilibrium_tangents(lin.stiffness_total().as_ref(), &dofs)
+                        .map_err(|e| format!("at the equilibrium s = {}: {e}", p.s))?;
+                Ok([t.col_as_slice(0).to_vec(), t.col_as_slice(1).to_vec()])
+            },
+        )
+        .collect()
+}
+
 /// The grid basis over the n × n grid of `points` (grid order, from
-/// [`grid_equilibria`] or [`sub_grid`]): Q through the equilibria, V by MSI
+/// [`grid_equilibria`] or [`sub_grid`]): Q through the equilibria (the
+/// bicubic Hermite interpolant when their `tangents` from
+/// [`grid_tangents`] are given, else the natural bicubic spline), V by MSI
 /// over the grid with the mass normalization (6.26).
-pub fn basis(mech: &Arc<Mechanism>, points: &[SweepPoint], n: usize) -> Result<GridBasis, String> {
+pub fn basis(
+    mech: &Arc<Mechanism>,
+    points: &[SweepPoint],
+    n: usize,
+    tangents: Option<&[[Vec<f64>; 2]]>,
+) -> Result<GridBasis, String> {
     let vecs = points
         .iter()
         .map(grid_vectors)
@@ -275,7 +307,11 @@ pub fn basis(mech: &Arc<Mechanism>, points: &[SweepPoint], n: usize) -> Result<G
         .collect::<Result<_, _>>()?;
     let qs: Vec<Vec<f64>> = points.iter().map(|p| p.q.clone()).collect();
     let g = grid_lines(n);
-    GridBasis::new(mech.q0(), g.clone(), g, &qs, &vecs, Some(&masses)).map_err(|e| e.to_string())
+    match tangents {
+        Some(t) => GridBasis::with_tangents(mech.q0(), g.clone(), g, &qs, t, &vecs, Some(&masses)),
+        None => GridBasis::new(mech.q0(), g.clone(), g, &qs, &vecs, Some(&masses)),
+    }
+    .map_err(|e| e.to_string())
 }
 
 /// The reduced coordinates of an equilibrium of `mech` held at the

@@ -2,6 +2,18 @@
 
 use std::fmt::Write;
 
+/// The machine's one-minute load average (`/proc/loadavg`) as a phrase for
+/// a report's wall times, such as "load average 0.17 at the start", or
+/// "load average unknown" where the system does not say. A report's times mean little without it
+/// on a 2-core machine that also builds.
+pub fn load_average_phrase() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_owned))
+        .map(|l| format!("load average {l} at the start"))
+        .unwrap_or_else(|| "load average unknown".into())
+}
+
 /// A markdown table.
 pub struct Table {
     header: Vec<String>,

@@ -49,6 +49,7 @@ mod msi;
 mod path;
 mod saved;
 mod spline;
+mod tangents;
 
 pub use basis::{
     fixed_basis_frequencies, modal_basis, per_mode_svd_basis, svd_modal_basis, Basis, FixedBasis,
@@ -69,6 +70,7 @@ pub use path::{
 };
 pub use saved::{dof_names, SavedBasis, SavedModel, FORMAT_VERSION};
 pub use spline::CubicSpline;
+pub use tangents::equilibrium_tangents;
 
 /// Failures of the reduction layer.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

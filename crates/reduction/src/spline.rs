@@ -146,6 +146,72 @@ pub(crate) fn interval_weights(s: &[f64], x: f64) -> (usize, [[f64; 4]; 4]) {
     )
 }
 
+/// The first derivatives at the knots `s` of the natural cubic spline
+/// through `y` (as [`natural_second_derivatives`]).
+pub(crate) fn natural_first_derivatives(s: &[f64], y: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let m = natural_second_derivatives(s, y);
+    (0..s.len())
+        .map(|k| {
+            let (i, w) = interval_weights(s, s[k]);
+            (0..y[k].len())
+                .map(|c| {
+                    w[1][0] * y[i][c]
+                        + w[1][1] * y[i + 1][c]
+                        + w[1][2] * m[i][c]
+                        + w[1][3] * m[i + 1][c]
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// As [`interval_weights`] for the cubic Hermite interpolant, whose data
+/// are the values and the first derivatives at the knots: derivative o at
+/// x is w[o][0] y_i + w[o][1] y_(i+1) + w[o][2] y′_i + w[o][3] y′_(i+1).
+/// C¹ where the derivatives are exact (an equilibrium path's tangents,
+/// [`crate::equilibrium_tangents`]), so that the interpolant's derivative
+/// at a knot is the path's own.
+pub(crate) fn hermite_interval_weights(s: &[f64], x: f64) -> (usize, [[f64; 4]; 4]) {
+    let n = s.len();
+    let i = match s.partition_point(|v| *v <= x) {
+        0 => 0,
+        p if p >= n => n - 2,
+        p => p - 1,
+    };
+    let h = s[i + 1] - s[i];
+    let t = (x - s[i]) / h;
+    let (t2, t3) = (t * t, t * t * t);
+    (
+        i,
+        [
+            [
+                2.0 * t3 - 3.0 * t2 + 1.0,
+                -2.0 * t3 + 3.0 * t2,
+                h * (t3 - 2.0 * t2 + t),
+                h * (t3 - t2),
+            ],
+            [
+                (6.0 * t2 - 6.0 * t) / h,
+                (-6.0 * t2 + 6.0 * t) / h,
+                3.0 * t2 - 4.0 * t + 1.0,
+                3.0 * t2 - 2.0 * t,
+            ],
+            [
+                (12.0 * t - 6.0) / (h * h),
+                (-12.0 * t + 6.0) / (h * h),
+                (6.0 * t - 4.0) / h,
+                (6.0 * t - 2.0) / h,
+            ],
+            [
+                12.0 / (h * h * h),
+                -12.0 / (h * h * h),
+                6.0 / (h * h),
+                6.0 / (h * h),
+            ],
+        ],
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

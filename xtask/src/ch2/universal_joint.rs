@@ -65,6 +65,12 @@ pub const MODELS: [Kind; 4] = [
 /// with p → q along +x, or along −x when `reversed`). `reversed` lists each
 /// element's nodes outer end first.
 pub fn scene(kind: Kind, reversed: bool, file: &str) -> String {
+    scene_with(kind, reversed, file, N)
+}
+
+/// [`scene`] with `n` elements (superelements from [`segment_with`] of the
+/// same `n`).
+pub fn scene_with(kind: Kind, reversed: bool, file: &str, n: usize) -> String {
     let mut nodes = vec![
         r#"(id: "G", at: [0.0, 0.0, 0.0])"#.to_string(),
         r#"(id: "U", at: [0.0, 0.0, 0.0])"#.to_string(),
@@ -85,7 +91,7 @@ pub fn scene(kind: Kind, reversed: bool, file: &str) -> String {
             ]
         })
         .collect();
-    let (chain_nodes, links) = chain::links(N, L);
+    let (chain_nodes, links) = chain::links(n, L);
     nodes.extend(chain_nodes);
     for chain::Link { k, from, to } in links {
         let (a, b) = if reversed { (&to, &from) } else { (&from, &to) };
@@ -127,7 +133,12 @@ pub fn scene(kind: Kind, reversed: bool, file: &str) -> String {
 /// The superelement of a segment, built with p → q along +x or, reversed,
 /// along −x.
 pub fn segment(reversed: bool) -> Result<Built, String> {
-    segments::beam_segment(L / N as f64, BY, BZ, MESH, reversed, 0)
+    segment_with(reversed, N)
+}
+
+/// The superelement of one of `n` segments.
+pub fn segment_with(reversed: bool, n: usize) -> Result<Built, String> {
+    segments::beam_segment(L / n as f64, BY, BZ, MESH, reversed, 0)
 }
 
 /// The tip response of one run.
