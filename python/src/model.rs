@@ -14,7 +14,7 @@ use flexmb::dynamics::{
 use flexmb::faer::Mat;
 use flexmb::linearize::{SweepOptions, SweepParameter};
 use flexmb::model::Mechanism;
-use flexmb::reduction::{MechanicalModel, ReducedModel as RsReduced, SavedBasis, SavedModel};
+use flexmb::reduction::{MechanicalModel, ReducedModel as RsReduced, SavedModel};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -676,10 +676,11 @@ impl ReducedModel {
         self.saved.description.clone()
     }
 
-    /// True for an interpolated basis (ibm-msi, ibm-mac).
+    /// True for an interpolated basis (ibm-msi, ibm-mac, or a grid basis
+    /// over two configuration coordinates).
     #[getter]
     fn interpolated(&self) -> bool {
-        matches!(self.saved.basis, SavedBasis::Interpolated { .. })
+        self.saved.basis.configuration_coordinates() > 0
     }
 
     /// The unreduced mechanism's `info()` plus n_z and the description.

@@ -182,6 +182,51 @@ pub fn basis(
     .map_err(|e| e.to_string())
 }
 
+/// ∂q/∂(x, y) (n_q × 2) at each of the held equilibria `points` of the
+/// end-effector's DOFs `dofs`: the static modes of the held DOFs from the
+/// tangent stiffness there ([`flexmb_reduction::equilibrium_tangents`]), in
+/// parallel.
+pub fn held_tangents(
+    mech: &Arc<Mechanism>,
+    dofs: [usize; 2],
+    points: &[SweepPoint],
+) -> Result<Vec<Mat<f64>>, String> {
+    points
+        .par_iter()
+        .map_init(
+            || Dynamics::new(mech.clone()),
+            |dy, p| {
+                dy.kinematics_mut().set_guess(&p.x);
+                let lin = dy.linearize_at_rest(0.0, &p.q).map_err(|e| e.to_string())?;
+                flexmb_reduction::equilibrium_tangents(lin.stiffness_total().as_ref(), &dofs)
+                    .map_err(|e| format!("the equilibrium at s = {}: {e}", p.s))
+            },
+        )
+        .collect()
+}
+
+/// The equilibrium path's tangents dq/ds at the path equilibria `points`
+/// (held on the path (4.1)): [`held_tangents`] times the path's unit tangent
+/// dP/ds. Given to [`InterpolatedBasis::with_tangents`], Q,s at every
+/// reference is the path's own tangent.
+pub fn path_tangents(
+    mech: &Arc<Mechanism>,
+    dofs: [usize; 2],
+    points: &[SweepPoint],
+) -> Result<Vec<Vec<f64>>, String> {
+    let path = Path4::new();
+    Ok(held_tangents(mech, dofs, points)?
+        .iter()
+        .zip(points)
+        .map(|(t, p)| {
+            let (_, d, _) = path.at(p.s);
+            (0..t.nrows())
+                .map(|i| t[(i, 0)] * d[0] + t[(i, 1)] * d[1])
+                .collect()
+        })
+        .collect())
+}
+
 /// The reduced model of `basis` on `mech` (its DOFs are the basis's).
 pub fn reduced<B: Basis + Clone + 'static>(
     mech: &Arc<Mechanism>,

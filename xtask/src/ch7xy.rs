@@ -262,28 +262,17 @@ pub fn grid_vectors(p: &SweepPoint) -> Result<Mat<f64>, String> {
 }
 
 /// The equilibrium surface's tangents ∂q/∂x and ∂q/∂y at each of `points`
-/// (held equilibria of the end-effector's DOFs `dofs`): the static modes of
-/// the held DOFs from the tangent stiffness there
-/// ([`flexmb_reduction::equilibrium_tangents`]), in parallel.
+/// (held equilibria of the end-effector's DOFs `dofs`;
+/// [`ch7::held_tangents`]).
 pub fn grid_tangents(
     mech: &Arc<Mechanism>,
     dofs: [usize; 2],
     points: &[SweepPoint],
 ) -> Result<Vec<[Vec<f64>; 2]>, String> {
-    points
-        .par_iter()
-        .map_init(
-            || Dynamics::new(mech.clone()),
-            |dy, p| {
-                dy.kinematics_mut().set_guess(&p.x);
-                let lin = dy.linearize_at_rest(0.0, &p.q).map_err(|e| e.to_string())?;
-                let t =
-                    flexmb_reduction::equilibrium_tangents(lin.stiffness_total().as_ref(), &dofs)
-                        .map_err(|e| format!("at the equilibrium s = {}: {e}", p.s))?;
-                Ok([t.col_as_slice(0).to_vec(), t.col_as_slice(1).to_vec()])
-            },
-        )
-        .collect()
+    Ok(ch7::held_tangents(mech, dofs, points)?
+        .iter()
+        .map(|t| [t.col_as_slice(0).to_vec(), t.col_as_slice(1).to_vec()])
+        .collect())
 }
 
 /// The grid basis over the n × n grid of `points` (grid order, from

@@ -92,7 +92,8 @@ pub struct Ch7Frequencies {
     /// The equilibria halfway between them (beyond the thesis), empty if
     /// not asked for.
     pub between: Vec<SweepPoint>,
-    /// IBM-u and IBM-c, in this order.
+    /// IBM-u, IBM-c and IBM-u with the path's tangents (beyond the
+    /// thesis), in this order.
     pub reduced: Vec<ReducedVariant>,
 }
 
@@ -100,6 +101,9 @@ pub struct Ch7Frequencies {
 pub struct ReducedVariant {
     /// Which one.
     pub variant: Variant,
+    /// Whether Q is the Hermite interpolant with the equilibrium path's
+    /// tangents ([`ch7::path_tangents`]), else the natural spline (6.23).
+    pub tangents: bool,
     /// Its interpolated basis.
     pub basis: InterpolatedBasis,
     /// The basis's wall time (s).
@@ -108,6 +112,18 @@ pub struct ReducedVariant {
     pub at_references: Vec<Vec<f64>>,
     /// And halfway between them.
     pub halfway: Vec<Vec<f64>>,
+}
+
+impl ReducedVariant {
+    /// "IBM-u", "IBM-c" or "IBM-u + tangents".
+    pub fn label(&self) -> String {
+        Self::label_of(self.variant, self.tangents)
+    }
+
+    fn label_of(v: Variant, tangents: bool) -> String {
+        let t = if tangents { " + tangents" } else { "" };
+        format!("{}{t}", v.label())
+    }
 }
 
 /// The reference configurations, IBM-u and IBM-c, and their eigenfrequencies
@@ -141,15 +157,26 @@ pub fn frequencies(
     };
     bar.finish();
     let mut reduced = vec![];
-    for v in [Variant::Unconstrained, Variant::Constrained] {
+    for (v, tangents) in [
+        (Variant::Unconstrained, false),
+        (Variant::Constrained, false),
+        (Variant::Unconstrained, true),
+    ] {
         let t = Instant::now();
-        let b = ch7::basis(&mech, dofs, &points, v, ch7::R)?;
+        let mut b = ch7::basis(&mech, dofs, &points, v, ch7::R)?;
+        if tangents {
+            b = b
+                .with_tangents(ch7::path_tangents(&mech, dofs, &points)?)
+                .map_err(|e| e.to_string())?;
+        }
         let basis_seconds = t.elapsed().as_secs_f64();
-        pg.println(&format!("{} basis in {basis_seconds:.1} s", v.label()));
+        let label = ReducedVariant::label_of(v, tangents);
+        pg.println(&format!("{label} basis in {basis_seconds:.1} s"));
         let at = ch7::reduced_frequencies(&mech, &b, &points, dofs, ch7::R)?;
         let mid = ch7::reduced_frequencies(&mech, &b, &between, dofs, ch7::R)?;
         reduced.push(ReducedVariant {
             variant: v,
+            tangents,
             basis: b,
             seconds: basis_seconds,
             at_references: at,
@@ -193,7 +220,10 @@ pub fn stored_curves(f: &Ch7Frequencies) -> Vec<StoredCurve> {
     })];
     for r in &f.reduced {
         out.push(curve(
-            &r.variant.label().to_lowercase().replace('-', "_"),
+            &r.label()
+                .to_lowercase()
+                .replace('-', "_")
+                .replace(" + ", "_"),
             &|i| r.at_references[i].clone(),
         ));
     }
@@ -222,8 +252,9 @@ pub fn recompute(root: &Path, pg: &Progress) -> Result<crate::regress::Recompute
 pub struct Ch7Results {
     /// The eigenfrequencies along the path.
     pub freq: Ch7Frequencies,
-    /// Closed-loop poles at s = 0: reduced IBM-u, and unreduced.
-    pub poles: [Vec<flexmb_linearize::DampedMode>; 2],
+    /// Closed-loop poles at s = 0: reduced IBM-u, unreduced, and IBM-u with
+    /// the path's tangents.
+    pub poles: [Vec<flexmb_linearize::DampedMode>; 3],
     /// The closed-loop runs: IBM-u from the undeflected configuration and
     /// from the gravity equilibrium, and the unreduced model.
     pub runs: Vec<Run>,
@@ -257,12 +288,16 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
     let refs = ch7::angle_references(&mut kin_model, 4 * o.n_reference)?;
     // 4. closed-loop poles at s = 0, without gravity
     let (lmech, _) = ch7::mechanism(root, false, Some(&refs))?;
-    let mut lm = ch7::reduced(&lmech, ibm_u)?;
-    let z0 = vec![0.0; lm.n_z()];
-    let lin = lm
-        .linearize(0.0, &z0, &z0, &z0)
-        .map_err(|e| e.to_string())?;
-    let reduced_poles = poles(&lin.m, &lin.damping, &lin.stiffness)?;
+    let reduced_poles_of = |b: &flexmb_reduction::InterpolatedBasis| {
+        let mut lm = ch7::reduced(&lmech, b)?;
+        let z0 = vec![0.0; lm.n_z()];
+        let lin = lm
+            .linearize(0.0, &z0, &z0, &z0)
+            .map_err(|e| e.to_string())?;
+        poles(&lin.m, &lin.damping, &lin.stiffness)
+    };
+    let reduced_poles = reduced_poles_of(ibm_u)?;
+    let tangent_poles = reduced_poles_of(&freq.reduced[2].basis)?;
     let mut dy = Dynamics::new(lmech.clone());
     let q0 = lmech.q0();
     let n = q0.len();
@@ -327,7 +362,7 @@ pub fn compute(root: &Path, o: &Ch7Options, pg: &Progress) -> Result<Ch7Results,
     ));
     Ok(Ch7Results {
         freq,
-        poles: [reduced_poles, unreduced_poles],
+        poles: [reduced_poles, unreduced_poles, tangent_poles],
         runs,
         reference,
         angles,
@@ -406,7 +441,7 @@ pub fn reproduce(root: &Path, out: &Path, pg: &Progress) -> Result<(), String> {
 }
 
 /// The relative differences of mode k between reduced model `v` (0: IBM-u,
-/// 1: IBM-c) and the unreduced one, at the reference configurations, or
+/// 1: IBM-c, 2: IBM-u + tangents) and the unreduced one, at the reference configurations, or
 /// halfway between them if `between`.
 pub fn mode_errors(f: &Ch7Frequencies, v: usize, k: usize, between: bool) -> Vec<f64> {
     let (points, reduced) = if between {
@@ -504,11 +539,7 @@ fn figures(r: &Ch7Results, out: &Path, figs: &mut Figures) -> std::io::Result<()
             p.push(Series::line(&format!("ω{} unreduced", k + 1), &s, &u));
             for r in &f.reduced {
                 let y: Vec<f64> = r.at_references.iter().map(|f| f[k]).collect();
-                p.push(Series::dashed(
-                    &format!("ω{} {}", k + 1, r.variant.label()),
-                    &s,
-                    &y,
-                ));
+                p.push(Series::dashed(&format!("ω{} {}", k + 1, r.label()), &s, &y));
             }
         }
         figs.save(&p, out, stem)?;
@@ -668,7 +699,7 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
     ]);
     for v in &r.freq.reduced {
         t.row(vec![
-            format!("{} basis", v.variant.label()),
+            format!("{} basis", v.label()),
             "–".into(),
             format!("{:.1} s", v.seconds),
         ]);
@@ -681,7 +712,11 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
          unreduced one (E.6), both with the end-effector's holding force as a dead \
          load: the relative difference of each mode, median and largest, at the {} \
          reference configurations (as the thesis) and at the {} equilibria halfway \
-         between them (beyond the thesis).\n",
+         between them (beyond the thesis). \"IBM-u + tangents\" (beyond the thesis) is \
+         IBM-u with Q the cubic Hermite interpolant of the references and the \
+         equilibrium path's tangents dq/ds there (`InterpolatedBasis::with_tangents`, \
+         docs/reduction.md): the natural spline's Q,s is not the path's tangent, which \
+         raises the mechanism modes ω1, ω2 near the path's ends and its junction.\n",
         r.freq.points.len(),
         r.freq.between.len()
     );
@@ -689,8 +724,10 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
         "mode",
         "IBM-c at the references",
         "IBM-u at the references",
+        "IBM-u + tangents at the references",
         "IBM-c halfway",
         "IBM-u halfway",
+        "IBM-u + tangents halfway",
     ]);
     for k in 0..ch7::R {
         let cell = |v: usize, between: bool| {
@@ -701,8 +738,10 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
             format!("ω{}", k + 1),
             cell(1, false),
             cell(0, false),
+            cell(2, false),
             cell(1, true),
             cell(0, true),
+            cell(2, true),
         ]);
     }
     let _ = writeln!(s, "{}", t.render());
@@ -713,6 +752,7 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
         "mode",
         "thesis (Hz, ζ)",
         "IBM-u (Hz, ζ)",
+        "IBM-u + tangents (Hz, ζ)",
         "unreduced (Hz, ζ)",
     ]);
     for k in 0..2 {
@@ -725,6 +765,7 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
             (k + 1).to_string(),
             format!("{}, {:.2}", ch7::THESIS_POLES[k].0, ch7::THESIS_POLES[k].1),
             f(&r.poles[0]),
+            f(&r.poles[2]),
             f(&r.poles[1]),
         ]);
     }

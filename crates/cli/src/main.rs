@@ -503,18 +503,18 @@ fn simulate(a: &SimulateArgs) -> Result<(), Failure> {
         pb.set_message(format!("{t:.4}"));
         Control::Continue
     };
-    let (mut model, description, interpolated) = match &a.reduced {
+    let (mut model, description, configuration) = match &a.reduced {
         None => {
             say!("{}", mech.summary());
             let dy: Box<dyn MechanicalModel> = Box::new(Dynamics::new(mech.clone()));
-            (dy, None, false)
+            (dy, None, 0)
         }
         Some(file) => {
-            let (model, d, interpolated) = reduced::model_to_simulate(&mech, file, &opts)?;
-            (model, Some(d), interpolated)
+            let (model, d, configuration) = reduced::model_to_simulate(&mech, file, &opts)?;
+            (model, Some(d), configuration)
         }
     };
-    let c0 = start_state(model.as_mut(), a.static_first, interpolated)?;
+    let c0 = start_state(model.as_mut(), a.static_first, configuration)?;
     let result = simulate_model(model.as_mut(), &c0, &opts, observer);
     pb.finish_and_clear();
     let (response, rows) = result?;
@@ -580,11 +580,12 @@ fn stopped_run(r: &Response, opts: &SimulationOptions) -> String {
 /// The coordinates a run starts from: the model's reference coordinates, or
 /// with `static_first` its static equilibrium under the loads and gravity at
 /// t = 0 ([`MechanicalModel::equilibrium_under_loads`]); the loads at full
-/// scale. An interpolated reduced model says where on its path it starts.
+/// scale. A reduced model with `configuration` > 0 configuration
+/// coordinates (interpolated: s; grid: s1, s2) says where it starts.
 fn start_state(
     model: &mut dyn MechanicalModel,
     static_first: bool,
-    interpolated: bool,
+    configuration: usize,
 ) -> Result<Vec<f64>, Failure> {
     let c0 = if static_first {
         let what = if model.is_reduced() {
@@ -600,10 +601,20 @@ fn start_state(
         model.reference_coordinates()
     };
     model.set_load_scale(1.0);
-    if interpolated {
+    if configuration > 0 {
+        let names = ["s", "(s1, s2)"];
+        let values: Vec<String> = c0[..configuration.min(2)]
+            .iter()
+            .map(|v| format!("{v:.6e}"))
+            .collect();
         say!(
-            "initial s = {:.6e} ({})",
-            c0[0],
+            "initial {} = {} ({})",
+            names[configuration.min(2) - 1],
+            if configuration == 1 {
+                values[0].clone()
+            } else {
+                format!("({})", values.join(", "))
+            },
             if static_first {
                 "static equilibrium"
             } else {

@@ -7,7 +7,7 @@ use crate::report::{count_bar, write_frequency_sweep, FrequencySweep};
 use crate::{Failure, SweepArgs};
 use flexmb_dynamics::{Control, Integrator, SimulationOptions};
 use flexmb_model::Mechanism;
-use flexmb_reduction::{MechanicalModel, ReducedModel, SavedBasis, SavedModel};
+use flexmb_reduction::{MechanicalModel, ReducedModel, SavedModel};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -30,12 +30,13 @@ fn load_model(mech: &Arc<Mechanism>, path: &Path) -> Result<(SavedModel, Reduced
 }
 
 /// The reduced model `model` of `mech` to simulate, its description, and
-/// whether its basis is interpolated; explicit integrators only.
+/// how many configuration coordinates its basis has (0 fixed, 1
+/// interpolated, 2 grid); explicit integrators only.
 pub(crate) fn model_to_simulate(
     mech: &Arc<Mechanism>,
     model: &Path,
     opts: &SimulationOptions,
-) -> Result<(Box<dyn MechanicalModel>, String, bool), Failure> {
+) -> Result<(Box<dyn MechanicalModel>, String, usize), Failure> {
     if opts.integrator == Integrator::GeneralizedAlpha {
         return Err(Failure::Input(
             "a reduced model is integrated with an explicit integrator (--integrator dopri5 or \
@@ -45,8 +46,8 @@ pub(crate) fn model_to_simulate(
         ));
     }
     let (saved, red) = load_model(mech, model)?;
-    let interpolated = matches!(saved.basis, SavedBasis::Interpolated { .. });
-    Ok((Box::new(red), saved.description, interpolated))
+    let configuration = saved.basis.configuration_coordinates();
+    Ok((Box::new(red), saved.description, configuration))
 }
 
 /// The reduced model's eigenfrequencies (F.7) at its static equilibria along

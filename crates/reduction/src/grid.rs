@@ -209,6 +209,11 @@ impl GridBasis {
         })
     }
 
+    /// The offset q0.
+    pub fn q0(&self) -> &[f64] {
+        &self.q0
+    }
+
     /// The knot data.
     pub fn knots(&self) -> &GridKnots {
         &self.knots

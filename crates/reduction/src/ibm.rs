@@ -25,6 +25,10 @@ pub struct Knots {
     pub qs: Vec<Vec<f64>>,
     /// The interpolation-ready base vectors at the knots (r columns each).
     pub w: Vec<Vec<Vec<f64>>>,
+    /// The equilibrium path's tangents dq/ds at the knots, when known
+    /// ([`InterpolatedBasis::with_tangents`]): Q is then their cubic
+    /// Hermite interpolant, else the natural spline of (6.23).
+    pub tangents: Option<Vec<Vec<f64>>>,
 }
 
 /// An interpolated basis q = Q(s) + V(s)η + q0, z = (s, η).
@@ -123,12 +127,50 @@ impl InterpolatedBasis {
         Ok(Self {
             q: CubicSpline::new(s.clone(), dq)?,
             v: CubicSpline::new(s.clone(), flat)?,
-            knots: Knots { s, qs, w },
+            knots: Knots {
+                s,
+                qs,
+                w,
+                tangents: None,
+            },
             work: SplineWork::default(),
             q0,
             n_q,
             r,
         })
+    }
+
+    /// The same basis with Q the cubic Hermite interpolant of the reference
+    /// configurations and the equilibrium path's `tangents` dq/ds there (one
+    /// per knot, n_q each; from [`crate::equilibrium_tangents`] times the
+    /// held DOFs' ds-derivatives). At a knot Q,s is then the path's own
+    /// tangent, where the natural spline's derivative strays into stiff
+    /// directions and raises the mechanism modes' Ritz values (see
+    /// [`crate::GridBasis::with_tangents`]).
+    ///
+    /// # Errors
+    ///
+    /// [`ReductionError::Invalid`] for a wrong count or length of tangents,
+    /// or a non-finite entry.
+    pub fn with_tangents(mut self, tangents: Vec<Vec<f64>>) -> Result<Self, ReductionError> {
+        if tangents.len() != self.knots.s.len() || tangents.iter().any(|t| t.len() != self.n_q) {
+            return Err(ReductionError::Invalid(format!(
+                "interpolated basis: {} tangents of length {} for {} knots and {} DOFs",
+                tangents.len(),
+                tangents.first().map_or(0, Vec::len),
+                self.knots.s.len(),
+                self.n_q
+            )));
+        }
+        let dq: Vec<Vec<f64>> = self
+            .knots
+            .qs
+            .iter()
+            .map(|q| q.iter().zip(&self.q0).map(|(a, b)| a - b).collect())
+            .collect();
+        self.q = CubicSpline::hermite(self.knots.s.clone(), dq, tangents.clone())?;
+        self.knots.tangents = Some(tangents);
+        Ok(self)
     }
 
     /// The knot data (for saving): s, the DOFs and the base vectors there.

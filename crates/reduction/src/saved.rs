@@ -3,7 +3,9 @@
 //! the mechanism's degrees of freedom when loaded, so that a model built once
 //! is simulated many times.
 
-use crate::{Basis, FixedBasis, InterpolatedBasis, ReducedModel, ReductionError};
+use crate::{
+    Basis, FixedBasis, GridBasis, GridKnots, InterpolatedBasis, ReducedModel, ReductionError,
+};
 use faer::Mat;
 use flexmb_model::Mechanism;
 use serde::{Deserialize, Serialize};
@@ -50,7 +52,40 @@ pub enum SavedBasis {
         q: Vec<Vec<f64>>,
         /// The base vectors at the knots (per knot, r columns).
         w: Vec<Vec<Vec<f64>>>,
+        /// The equilibrium path's tangents dq/ds at the knots, if Q is
+        /// their Hermite interpolant ([`InterpolatedBasis::with_tangents`]).
+        #[serde(default)]
+        tangents: Option<Vec<Vec<f64>>>,
     },
+    /// G = Q(s1, s2) + V(s1, s2)η + q0 over a tensor grid ([`GridBasis`]).
+    Grid {
+        /// Offset q0.
+        q0: Vec<f64>,
+        /// The grid lines of s1.
+        s1: Vec<f64>,
+        /// The grid lines of s2.
+        s2: Vec<f64>,
+        /// The DOFs at the grid points (point (i, j) at index i + n1 j).
+        q: Vec<Vec<f64>>,
+        /// The base vectors there (per point, r columns).
+        w: Vec<Vec<Vec<f64>>>,
+        /// The equilibrium tangents ∂q/∂s1, ∂q/∂s2 there, if Q is the
+        /// Hermite interpolant ([`GridBasis::with_tangents`]).
+        #[serde(default)]
+        tangents: Option<Vec<[Vec<f64>; 2]>>,
+    },
+}
+
+impl SavedBasis {
+    /// How many of the reduced coordinates are configuration coordinates
+    /// (s of an interpolated basis, s1 and s2 of a grid): 0, 1 or 2.
+    pub fn configuration_coordinates(&self) -> usize {
+        match self {
+            Self::Fixed { .. } => 0,
+            Self::Interpolated { .. } => 1,
+            Self::Grid { .. } => 2,
+        }
+    }
 }
 
 /// The names of a mechanism's degrees of freedom.
@@ -96,6 +131,27 @@ impl SavedModel {
                 s: k.s.clone(),
                 q: k.qs.clone(),
                 w: k.w.clone(),
+                tangents: k.tangents.clone(),
+            },
+        }
+    }
+
+    /// A grid basis of `mech` (beyond the thesis: two configuration
+    /// coordinates).
+    pub fn grid(description: &str, scene: &str, mech: &Mechanism, b: &GridBasis) -> Self {
+        let k = b.knots();
+        Self {
+            format: FORMAT_VERSION,
+            description: description.into(),
+            scene: scene.into(),
+            dofs: dof_names(mech),
+            basis: SavedBasis::Grid {
+                q0: b.q0().to_vec(),
+                s1: k.s1.clone(),
+                s2: k.s2.clone(),
+                q: k.qs.clone(),
+                w: k.w.clone(),
+                tangents: k.tangents.clone(),
             },
         }
     }
@@ -157,7 +213,9 @@ impl SavedModel {
         }
         let n_q = names.len();
         let q0_len = match &self.basis {
-            SavedBasis::Fixed { q0, .. } | SavedBasis::Interpolated { q0, .. } => q0.len(),
+            SavedBasis::Fixed { q0, .. }
+            | SavedBasis::Interpolated { q0, .. }
+            | SavedBasis::Grid { q0, .. } => q0.len(),
         };
         if q0_len != n_q {
             return Err(ReductionError::Invalid(format!(
@@ -181,7 +239,13 @@ impl SavedModel {
                     v: Mat::from_fn(n, vectors.len(), |i, j| vectors[j][i]),
                 }))
             }
-            SavedBasis::Interpolated { q0, s, q, w } => {
+            SavedBasis::Interpolated {
+                q0,
+                s,
+                q,
+                w,
+                tangents,
+            } => {
                 if !finite(q0)
                     || !finite(s)
                     || q.iter().any(|v| !finite(v))
@@ -191,13 +255,30 @@ impl SavedModel {
                         "interpolated basis: non-finite values".into(),
                     ));
                 }
-                Ok(Box::new(InterpolatedBasis::from_knots(
-                    q0.clone(),
-                    s.clone(),
-                    q.clone(),
-                    w.clone(),
-                )?))
+                let b = InterpolatedBasis::from_knots(q0.clone(), s.clone(), q.clone(), w.clone())?;
+                Ok(Box::new(match tangents {
+                    Some(t) => b.with_tangents(t.clone())?,
+                    None => b,
+                }))
             }
+            // sizes and finiteness are checked by from_knots
+            SavedBasis::Grid {
+                q0,
+                s1,
+                s2,
+                q,
+                w,
+                tangents,
+            } => Ok(Box::new(GridBasis::from_knots(
+                q0.clone(),
+                GridKnots {
+                    s1: s1.clone(),
+                    s2: s2.clone(),
+                    qs: q.clone(),
+                    w: w.clone(),
+                    tangents: tangents.clone(),
+                },
+            )?)),
         }
     }
 

@@ -1,15 +1,19 @@
 //! Natural C² cubic splines of vector-valued data, with derivatives up to the
-//! third order (thesis (F.6): the third derivative is constant per interval).
+//! third order (thesis (F.6): the third derivative is constant per interval),
+//! and cubic Hermite interpolants of values with their first derivatives.
 
 use crate::ReductionError;
 
-/// A natural cubic spline through (s_i, y_i), y_i ∈ ℝᵈ.
+/// A natural cubic spline through (s_i, y_i), y_i ∈ ℝᵈ, or the cubic
+/// Hermite interpolant of (s_i, y_i, y′_i).
 #[derive(Clone, Debug)]
 pub struct CubicSpline {
     s: Vec<f64>,
     y: Vec<Vec<f64>>,
-    /// Second derivatives at the knots.
+    /// Second derivatives at the knots (natural), or the given first
+    /// derivatives (Hermite).
     m: Vec<Vec<f64>>,
+    hermite: bool,
 }
 
 impl CubicSpline {
@@ -30,7 +34,38 @@ impl CubicSpline {
             ));
         }
         let m = natural_second_derivatives(&s, &y);
-        Ok(Self { s, y, m })
+        Ok(Self {
+            s,
+            y,
+            m,
+            hermite: false,
+        })
+    }
+
+    /// The cubic Hermite interpolant of the values `y` and first derivatives
+    /// `dy` at the knots `s` (C¹; its derivative at a knot is the given one).
+    pub fn hermite(
+        s: Vec<f64>,
+        y: Vec<Vec<f64>>,
+        dy: Vec<Vec<f64>>,
+    ) -> Result<Self, ReductionError> {
+        let mut sp = Self::new(s, y)?;
+        let d = sp.y[0].len();
+        if dy.len() != sp.s.len() || dy.iter().any(|v| v.len() != d) {
+            return Err(ReductionError::Invalid(format!(
+                "a Hermite spline needs one derivative of length {d} per knot ({} knots, {} derivatives)",
+                sp.s.len(),
+                dy.len()
+            )));
+        }
+        if dy.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(ReductionError::Invalid(
+                "a Hermite spline's derivative is not finite".into(),
+            ));
+        }
+        sp.m = dy;
+        sp.hermite = true;
+        Ok(sp)
     }
 
     /// The range of the knots.
@@ -41,7 +76,11 @@ impl CubicSpline {
     /// Value and the first three derivatives at s (outside the knots the end
     /// cubic is extended), written into `out[0..4]` (each of length d).
     pub fn eval(&self, s: f64, out: &mut [Vec<f64>; 4]) {
-        let (i, w) = interval_weights(&self.s, s);
+        let (i, w) = if self.hermite {
+            hermite_interval_weights(&self.s, s)
+        } else {
+            interval_weights(&self.s, s)
+        };
         let (y0, y1, m0, m1) = (&self.y[i], &self.y[i + 1], &self.m[i], &self.m[i + 1]);
         for (o, w) in w.iter().enumerate() {
             for c in 0..y0.len() {
@@ -215,6 +254,45 @@ pub(crate) fn hermite_interval_weights(s: &[f64], x: f64) -> (usize, [[f64; 4]; 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The Hermite interpolant takes the given slopes, is exact for cubics,
+    /// its derivatives match central differences, and bad slopes are refused.
+    #[test]
+    fn the_hermite_form_takes_its_slopes_and_is_exact_for_cubics() {
+        let s: Vec<f64> = vec![0.0, 0.3, 0.5, 1.1, 1.4];
+        let f = |x: f64| vec![x * x * x - 2.0 * x, 1.0 + x];
+        let df = |x: f64| vec![3.0 * x * x - 2.0, 1.0];
+        let sp = CubicSpline::hermite(
+            s.clone(),
+            s.iter().map(|x| f(*x)).collect(),
+            s.iter().map(|x| df(*x)).collect(),
+        )
+        .unwrap();
+        let mut w = sp.work();
+        for x in [0.0, 0.1, 0.42, 0.8, 1.4, 1.6] {
+            sp.eval(x, &mut w);
+            for c in 0..2 {
+                assert!((w[0][c] - f(x)[c]).abs() < 1e-14, "value at {x}");
+                assert!((w[1][c] - df(x)[c]).abs() < 1e-13, "slope at {x}");
+            }
+            assert!((w[2][0] - 6.0 * x).abs() < 1e-12 && (w[3][0] - 6.0).abs() < 1e-11);
+        }
+        let (h, mut p, mut m) = (1e-6, sp.work(), sp.work());
+        sp.eval(0.7, &mut w);
+        sp.eval(0.7 + h, &mut p);
+        sp.eval(0.7 - h, &mut m);
+        for o in 1..4 {
+            let fd = (p[o - 1][0] - m[o - 1][0]) / (2.0 * h);
+            assert!(
+                (fd - w[o][0]).abs() < 1e-5 * (1.0 + w[o][0].abs()),
+                "order {o}"
+            );
+        }
+        let y: Vec<Vec<f64>> = s.iter().map(|x| f(*x)).collect();
+        assert!(CubicSpline::hermite(s.clone(), y.clone(), vec![vec![0.0, 0.0]; 4]).is_err());
+        assert!(CubicSpline::hermite(s.clone(), y.clone(), vec![vec![0.0]; 5]).is_err());
+        assert!(CubicSpline::hermite(s, y, vec![vec![f64::NAN, 0.0]; 5]).is_err());
+    }
 
     #[test]
     fn interpolates_is_c2_and_its_derivatives_match_differences() {

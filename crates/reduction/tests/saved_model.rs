@@ -106,6 +106,43 @@ fn interpolated_model_round_trip_keeps_configurations_and_frequencies() {
         "{f1:?} vs {:?}",
         pts[2].frequencies_hz
     );
+    // with tangents (central differences of the knots' DOFs): they are
+    // saved and restored, Q differs from the natural spline's between knots
+    let tangents: Vec<Vec<f64>> = (0..pts.len())
+        .map(|i| {
+            let (a, c) = (i.saturating_sub(1), (i + 1).min(pts.len() - 1));
+            (0..pts[i].q.len())
+                .map(|j| (pts[c].q[j] - pts[a].q[j]) / (pts[c].s - pts[a].s))
+                .collect()
+        })
+        .collect();
+    let bt =
+        interpolated_basis_from_sweep(mech.q0(), 0, &pts, 1..3, SubspaceInterpolation::Msi, true)
+            .unwrap()
+            .with_tangents(tangents.clone())
+            .unwrap();
+    let saved = SavedModel::interpolated("MSI-3 + tangents", "planar nodal", &mech, &bt);
+    let path = temp("ibm_t.ron");
+    saved.save(&path).unwrap();
+    let loaded = SavedModel::load(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    let mut with_t = ReducedModel::new(mech.clone(), Box::new(bt)).unwrap();
+    let mut restored = loaded.into_model(mech.clone()).unwrap();
+    let qt = with_t.full_coordinates(&z);
+    assert!(same(&qt, &restored.full_coordinates(&z), 1e-14));
+    assert!(
+        !same(&qt, &before.full_coordinates(&z), 1e-12),
+        "the tangents changed nothing"
+    );
+    // a wrong count of tangents is refused
+    let b2 =
+        interpolated_basis_from_sweep(mech.q0(), 0, &pts, 1..3, SubspaceInterpolation::Msi, true)
+            .unwrap();
+    let e = b2
+        .with_tangents(tangents[1..].to_vec())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("4 tangents") && e.contains("5 knots"), "{e}");
 }
 
 #[test]
@@ -134,6 +171,85 @@ fn a_misspelt_field_is_refused_with_the_nearest_name() {
     std::fs::remove_file(&path).ok();
     assert!(
         e.contains(":2:") && e.contains("`vector`") && e.contains("did you mean `vectors`?"),
+        "{e}"
+    );
+}
+
+/// A grid basis (two configuration coordinates), natural and with the
+/// tangents, written and read back: the same configurations and G,z between
+/// the grid points; a grid whose data do not fill it is refused by name.
+#[test]
+fn grid_model_round_trip_keeps_configurations_in_both_forms() {
+    let mech = Arc::new(scene().build(None).unwrap());
+    let q0 = mech.q0();
+    let n = q0.len();
+    let (s1, s2) = (vec![-0.01, 0.0, 0.012], vec![-0.02, 0.0, 0.01, 0.03]);
+    let pts: Vec<(f64, f64)> = s2
+        .iter()
+        .flat_map(|b| s1.iter().map(move |a| (*a, *b)))
+        .collect();
+    let q: Vec<Vec<f64>> = pts
+        .iter()
+        .map(|(a, b)| {
+            (0..n)
+                .map(|i| q0[i] + 1e-3 * ((i as f64 + 1.0) * a).sin() + 1e-3 * a * b)
+                .collect()
+        })
+        .collect();
+    let t: Vec<[Vec<f64>; 2]> = pts
+        .iter()
+        .map(|(a, b)| {
+            [
+                (0..n)
+                    .map(|i| 1e-3 * (i as f64 + 1.0) * ((i as f64 + 1.0) * a).cos() + 1e-3 * b)
+                    .collect(),
+                (0..n).map(|_| 1e-3 * a).collect(),
+            ]
+        })
+        .collect();
+    let v: Vec<faer::Mat<f64>> = pts
+        .iter()
+        .map(|(a, b)| faer::Mat::from_fn(n, 2, |i, j| ((i + 3 * j) as f64 + a - b).cos()))
+        .collect();
+    for tangents in [None, Some(&t[..])] {
+        let b = match tangents {
+            None => GridBasis::new(q0.clone(), s1.clone(), s2.clone(), &q, &v, None),
+            Some(t) => {
+                GridBasis::with_tangents(q0.clone(), s1.clone(), s2.clone(), &q, t, &v, None)
+            }
+        }
+        .unwrap();
+        let saved = SavedModel::grid("grid", "planar", &mech, &b);
+        assert_eq!(saved.basis.configuration_coordinates(), 2);
+        let path = temp("grid.ron");
+        saved.save(&path).unwrap();
+        let loaded = SavedModel::load(&path).unwrap();
+        std::fs::remove_file(&path).ok();
+        let after = loaded.basis_for(&mech).unwrap();
+        let z = [0.004, 0.017, 1e-4, -2e-4];
+        let (mut qa, mut qb) = (vec![0.0; n], vec![0.0; n]);
+        let (mut ga, mut gb) = (faer::Mat::zeros(n, 4), faer::Mat::zeros(n, 4));
+        let (mut ca, mut cb) = (vec![0.0; n], vec![0.0; n]);
+        b.eval(&z, &[0.1, -0.2, 0.3, 0.0], &mut qa, &mut ga, &mut ca);
+        after.eval(&z, &[0.1, -0.2, 0.3, 0.0], &mut qb, &mut gb, &mut cb);
+        assert!(same(&qa, &qb, 1e-15) && same(&ca, &cb, 1e-15));
+        assert!((0..n).all(|i| (0..4).all(|k| ga[(i, k)] == gb[(i, k)])));
+        if tangents.is_some() {
+            // the tangents came back: Q,s1 at a grid point is the tangent
+            after.eval(&[0.0, 0.0, 0.0, 0.0], &[0.0; 4], &mut qb, &mut gb, &mut cb);
+            let k = 1 + 3; // point (1, 1)
+            assert!((0..n).all(|i| (gb[(i, 0)] - t[k][0][i]).abs() < 1e-15));
+        }
+    }
+    // one configuration short: refused when applied, with the sizes named
+    let b = GridBasis::new(q0.clone(), s1.clone(), s2.clone(), &q, &v, None).unwrap();
+    let mut saved = SavedModel::grid("grid", "planar", &mech, &b);
+    if let SavedBasis::Grid { q, .. } = &mut saved.basis {
+        q.pop();
+    }
+    let e = saved.basis_for(&mech).err().expect("refused").to_string();
+    assert!(
+        e.contains("grid basis") && e.contains("inconsistent sizes"),
         "{e}"
     );
 }
