@@ -319,3 +319,12 @@ pub fn fixed_basis_frequencies(
     let kz = v.transpose() * lin.stiffness_total() * v;
     Ok(generalized_symmetric(&kz, &mz, count)?.frequencies_hz())
 }
+
+/// The index of the configuration in `qs` nearest to `q0` (Euclidean; 0 if
+/// `qs` is empty): where an interpolated basis's reference coordinates lie.
+pub(crate) fn nearest_configuration(qs: &[Vec<f64>], q0: &[f64]) -> usize {
+    let dist = |q: &Vec<f64>| q.iter().zip(q0).map(|(a, b)| (a - b).powi(2)).sum::<f64>();
+    (0..qs.len())
+        .min_by(|a, b| dist(&qs[*a]).total_cmp(&dist(&qs[*b])))
+        .unwrap_or(0)
+}

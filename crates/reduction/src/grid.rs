@@ -380,15 +380,7 @@ impl Basis for GridBasis {
     }
     /// (s1, s2, 0) at the grid point whose configuration is closest to q0.
     fn z_reference(&self) -> Vec<f64> {
-        let dist = |q: &Vec<f64>| {
-            q.iter()
-                .zip(&self.q0)
-                .map(|(a, b)| (a - b).powi(2))
-                .sum::<f64>()
-        };
-        let k = (0..self.knots.qs.len())
-            .min_by(|a, b| dist(&self.knots.qs[*a]).total_cmp(&dist(&self.knots.qs[*b])))
-            .unwrap_or(0);
+        let k = crate::basis::nearest_configuration(&self.knots.qs, &self.q0);
         let n1 = self.knots.s1.len();
         let mut z = vec![0.0; 2 + self.r];
         z[0] = self.knots.s1[k % n1];

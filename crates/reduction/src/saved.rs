@@ -99,18 +99,17 @@ pub fn dof_names(mech: &Mechanism) -> Vec<String> {
 impl SavedModel {
     /// A fixed basis of `mech`.
     pub fn fixed(description: &str, scene: &str, mech: &Mechanism, b: &FixedBasis) -> Self {
-        Self {
-            format: FORMAT_VERSION,
-            description: description.into(),
-            scene: scene.into(),
-            dofs: dof_names(mech),
-            basis: SavedBasis::Fixed {
+        Self::of(
+            description,
+            scene,
+            mech,
+            SavedBasis::Fixed {
                 q0: b.q0.clone(),
                 vectors: (0..b.v.ncols())
                     .map(|j| b.v.col_as_slice(j).to_vec())
                     .collect(),
             },
-        }
+        )
     }
 
     /// An interpolated basis of `mech`.
@@ -121,18 +120,28 @@ impl SavedModel {
         b: &InterpolatedBasis,
     ) -> Self {
         let k = b.knots();
-        Self {
-            format: FORMAT_VERSION,
-            description: description.into(),
-            scene: scene.into(),
-            dofs: dof_names(mech),
-            basis: SavedBasis::Interpolated {
+        Self::of(
+            description,
+            scene,
+            mech,
+            SavedBasis::Interpolated {
                 q0: b.q0().to_vec(),
                 s: k.s.clone(),
                 q: k.qs.clone(),
                 w: k.w.clone(),
                 tangents: k.tangents.clone(),
             },
+        )
+    }
+
+    /// A saved model of `mech` with the basis data `basis`.
+    fn of(description: &str, scene: &str, mech: &Mechanism, basis: SavedBasis) -> Self {
+        Self {
+            format: FORMAT_VERSION,
+            description: description.into(),
+            scene: scene.into(),
+            dofs: dof_names(mech),
+            basis,
         }
     }
 
@@ -140,12 +149,11 @@ impl SavedModel {
     /// coordinates).
     pub fn grid(description: &str, scene: &str, mech: &Mechanism, b: &GridBasis) -> Self {
         let k = b.knots();
-        Self {
-            format: FORMAT_VERSION,
-            description: description.into(),
-            scene: scene.into(),
-            dofs: dof_names(mech),
-            basis: SavedBasis::Grid {
+        Self::of(
+            description,
+            scene,
+            mech,
+            SavedBasis::Grid {
                 q0: b.q0().to_vec(),
                 s1: k.s1.clone(),
                 s2: k.s2.clone(),
@@ -153,7 +161,7 @@ impl SavedModel {
                 w: k.w.clone(),
                 tangents: k.tangents.clone(),
             },
-        }
+        )
     }
 
     /// Writes the model as RON.

@@ -147,6 +147,17 @@ pub(crate) fn natural_second_derivatives(s: &[f64], y: &[Vec<f64>]) -> Vec<Vec<f
     m
 }
 
+/// The interval i of the knots `s` (at least 2) that holds `x`, the end
+/// intervals extended beyond the knots.
+fn knot_interval(s: &[f64], x: f64) -> usize {
+    let n = s.len();
+    match s.partition_point(|v| *v <= x) {
+        0 => 0,
+        p if p >= n => n - 2,
+        p => p - 1,
+    }
+}
+
 /// The interval i of the knots `s` that holds `x` (the end intervals
 /// extended beyond the knots) and the weights of a cubic spline's value and
 /// first three derivatives there: derivative o at x is
@@ -155,12 +166,7 @@ pub(crate) fn natural_second_derivatives(s: &[f64], y: &[Vec<f64>]) -> Vec<Vec<f
 /// its data, so the same weights serve every component and the tensor
 /// product of two of them (the bicubic spline of [`crate::GridBasis`]).
 pub(crate) fn interval_weights(s: &[f64], x: f64) -> (usize, [[f64; 4]; 4]) {
-    let n = s.len();
-    let i = match s.partition_point(|v| *v <= x) {
-        0 => 0,
-        p if p >= n => n - 2,
-        p => p - 1,
-    };
+    let i = knot_interval(s, x);
     let h = s[i + 1] - s[i];
     let a = (s[i + 1] - x) / h;
     let b = (x - s[i]) / h;
@@ -211,12 +217,7 @@ pub(crate) fn natural_first_derivatives(s: &[f64], y: &[Vec<f64>]) -> Vec<Vec<f6
 /// [`crate::equilibrium_tangents`]), so that the interpolant's derivative
 /// at a knot is the path's own.
 pub(crate) fn hermite_interval_weights(s: &[f64], x: f64) -> (usize, [[f64; 4]; 4]) {
-    let n = s.len();
-    let i = match s.partition_point(|v| *v <= x) {
-        0 => 0,
-        p if p >= n => n - 2,
-        p => p - 1,
-    };
+    let i = knot_interval(s, x);
     let h = s[i + 1] - s[i];
     let t = (x - s[i]) / h;
     let (t2, t3) = (t * t, t * t * t);
