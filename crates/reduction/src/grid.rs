@@ -89,7 +89,7 @@ impl GridBasis {
     /// tangents themselves. Measured on the chapter-7 mechanism (5 × 5
     /// grid): the reduced ω1, ω2 at the grid points within 5e-5 of the
     /// unreduced ones, where the natural spline's derivatives put them 33
-    /// and 25 times too high (their small components in directions 10⁴
+    /// and 27 times too high (their small components in directions 10⁴
     /// times stiffer than the mechanism's motion).
     pub fn with_tangents(
         q0: Vec<f64>,
