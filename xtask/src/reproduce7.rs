@@ -835,5 +835,15 @@ fn report(o: &Ch7Options, r: &Ch7Results, figs: &Figures, wall: f64) -> String {
             || f.starts_with("fig7_7")
     });
     let _ = Path4::new();
+    let _ = writeln!(
+        s,
+        "## Beyond the thesis: two configuration coordinates\n\n\
+         The interpolated basis over the end-effector's x and y on the whole 100 × 100 mm \
+         workspace (the thesis's recommendation 3), how many reference configurations it \
+         needs for ω1–ω8 within 1 %, with and without the equilibrium tangents, and its \
+         closed loop on a circle off the path (4.1): `cargo xtask reproduce ch7xy`, \
+         `results/ch7xy/report.md` (its own command: its 17 × 17 sweep takes minutes; \
+         `cargo xtask reproduce all` runs both).\n"
+    );
     s
 }
